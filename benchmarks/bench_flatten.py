@@ -1,0 +1,633 @@
+"""Time and quality of `patterns` flattening against libigl's LSCM, ARAP and SLIM.
+
+Run from the repository root::
+
+    /work/venv/bin/python benchmarks/bench_flatten.py                 # everything
+    /work/venv/bin/python benchmarks/bench_flatten.py --sizes 1k,10k --no-corpus
+    /work/venv/bin/python benchmarks/bench_flatten.py --markdown > tables.md
+
+Meshes
+------
+* every ``*.obj`` / ``*.off`` in ``../shared/corpus/`` relative to the repository
+  root, loaded with ``trimesh.load(path, process=False)`` (skipped, with the
+  reason printed, when the folder is absent or ``--no-corpus`` is given);
+* generated surfaces at about 1k, 10k, 100k and 1M faces: a 60 degree spherical
+  cap (``cap60``), a paraboloid dish, a saddle and a half cylinder.
+
+Methods
+-------
+* ``isometric``, ``conformal``: :func:`patterns.flatten_mesh`; the time covers the
+  whole call (input validation, the grower and the overlap verdict).
+* ``lscm``: ``igl.lscm`` with the two farthest-apart boundary vertices pinned at
+  their 3D distance apart.  LSCM has no scale of its own, so before measuring its
+  uv is multiplied by the single factor that makes the total flat area equal to
+  the total 3D area.  Nothing else is ever rescaled.
+* ``arap``: as in libigl's tutorial: boundary to a circle
+  (``igl.map_vertices_to_circle``), harmonic initialisation (``igl.harmonic``),
+  then ``igl.arap_precomputation`` (2D) and ``igl.arap_solve`` with the default
+  ``igl.ARAPData`` (10 iterations).  One vertex is held at its initial position:
+  that only fixes the translation, which the ARAP energy does not see (with no
+  fixed vertex ``arap_precomputation`` fails on some meshes).  The time includes the
+  harmonic initialisation, which is also given on its own in the note column.
+* ``slim``: ``igl.slim_precompute`` / ``igl.slim_solve`` with the symmetric
+  Dirichlet energy from the same harmonic initialisation, no constraints, a fixed
+  number of iterations; only up to ``--max-faces-slim`` faces.
+
+Every row is measured by the same code, :func:`patterns.distortion` (edge strain
+RMS and max, folded triangles) and :func:`patterns.overlap_verdict` (one-to-one),
+outside the timed region.  Times are the best of 3 runs up to
+``REPEAT_LIMIT`` faces and of 1 run above, all methods in the same process.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parent.parent
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+import igl
+import trimesh
+
+import patterns
+from patterns import surfaces
+from patterns.measure import folded_faces
+
+CORPUS = REPO.parent / "shared" / "corpus"
+"""The shared corpus of real disk-topology meshes."""
+
+SIZES = {"1k": 1_000, "10k": 10_000, "100k": 100_000, "1M": 1_000_000}
+"""Face counts of the generated surfaces, by the label used on the command line."""
+
+ALL_METHODS = ("isometric", "conformal", "lscm", "arap", "slim")
+"""Every method the benchmark knows, in the order the rows are printed."""
+
+REPEAT_LIMIT = 200_000
+"""Meshes with at most this many faces are timed best of 3, larger ones once."""
+
+SLIM_ITERATIONS = 20
+"""Iterations of ``igl.slim_solve``."""
+
+
+# --------------------------------------------------------------------------- #
+# Rows and formatting
+# --------------------------------------------------------------------------- #
+
+
+@dataclass
+class Row:
+    """One line of the result table: one method on one mesh.
+
+    Attributes
+    ----------
+    mesh : str
+    faces : int
+    method : str
+    seconds : float or None
+        Best wall-clock time, or None when the method did not run.
+    rms, max : float or None
+        Edge strain ``|l_flat / l_3d - 1|``: RMS and maximum over all edges.
+    folds : int or None
+        Triangles with flat signed area <= 0.
+    one_to_one : bool or None
+        The overlap verdict; None when it could not be computed.
+    note : str
+        Errors, skips, rescale factors, sub-timings.
+    """
+
+    mesh: str
+    faces: int
+    method: str
+    seconds: float | None = None
+    rms: float | None = None
+    max: float | None = None
+    folds: int | None = None
+    one_to_one: bool | None = None
+    note: str = ""
+
+
+COLUMNS = ("mesh", "faces", "method", "seconds", "/ LSCM", "strain RMS %", "strain max %",
+           "folds", "one-to-one", "note")
+"""Table header."""
+
+
+def _percent(x: float | None) -> str:
+    if x is None:
+        return ""
+    if not np.isfinite(x):
+        return str(x)
+    p = 100.0 * x
+    return f"{p:.3g}" if p < 1e4 else f"{p:.2e}"
+
+
+def _cells(row: Row, lscm_seconds: float | None) -> list[str]:
+    """Format one row as table cells (the ratio is to the LSCM time on the same mesh)."""
+    if row.seconds is not None and lscm_seconds:
+        ratio = f"{row.seconds / lscm_seconds:.2f}"
+    else:
+        ratio = ""
+    verdict = {True: "yes", False: "no", None: ""}[row.one_to_one]
+    return [
+        row.mesh,
+        str(row.faces),
+        row.method,
+        "" if row.seconds is None else f"{row.seconds:.3f}",
+        ratio,
+        _percent(row.rms),
+        _percent(row.max),
+        "" if row.folds is None else str(row.folds),
+        verdict,
+        row.note,
+    ]
+
+
+WIDTHS = (18, 8, 10, 9, 7, 13, 13, 7, 10, 0)
+"""Column widths of the plain-text table."""
+
+
+def plain_line(cells) -> str:
+    """One fixed-width plain-text table line."""
+    parts = []
+    for cell, width in zip(cells, WIDTHS, strict=True):
+        parts.append(f"{cell:<{width}}" if width else cell)
+    return " ".join(parts).rstrip()
+
+
+def markdown_table(groups: list[list[Row]]) -> str:
+    """Markdown table of several meshes' rows (each group is one mesh)."""
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    for rows in groups:
+        lscm = next((r.seconds for r in rows if r.method == "lscm"), None)
+        for row in rows:
+            cells = [c.replace("|", "/") for c in _cells(row, lscm)]
+            lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------- #
+# Meshes
+# --------------------------------------------------------------------------- #
+
+
+def parse_sizes(text: str) -> list[tuple[str, int]]:
+    """Parse ``"1k,10k,100k,1M"`` into ``[(label, n_faces), ...]``.
+
+    Raises
+    ------
+    SystemExit
+        On an unknown label.
+    """
+    out = []
+    for label in (s.strip() for s in text.split(",") if s.strip()):
+        key = next((k for k in SIZES if k.lower() == label.lower()), None)
+        if key is None:
+            raise SystemExit(f"unknown size {label!r}; choose from {', '.join(SIZES)}")
+        out.append((key, SIZES[key]))
+    return out
+
+
+def cylinder_cells(n_faces: int, radius: float = 200.0, height: float = 300.0,
+                   angle: float = 180.0) -> tuple[int, int]:
+    """Cells ``(n_around, n_along)`` with ``2 * n_around * n_along ~ n_faces``, near square.
+
+    The arc is ``radius * radians(angle)`` long, the height ``height``; the cell
+    counts are chosen in that ratio.
+    """
+    aspect = radius * np.radians(angle) / height
+    n_along = max(1, round(float(np.sqrt(n_faces / (2.0 * aspect)))))
+    n_around = max(1, round(n_faces / (2.0 * n_along)))
+    return n_around, n_along
+
+
+def generated_meshes(sizes: list[tuple[str, int]]):
+    """Yield ``(name, vertices, faces)`` for every generated surface and size.
+
+    Generated lazily so that only one 1M-face mesh is in memory at a time.
+    """
+    for label, n in sizes:
+        yield f"cap60 {label}", *surfaces.spherical_cap(radius=100.0, half_angle=30.0, n_faces=n)
+        yield f"dish {label}", *surfaces.paraboloid_dish(diameter=600.0, sag=54.0, n_faces=n)
+        yield f"saddle {label}", *surfaces.saddle(diameter=400.0, height=40.0, n_faces=n)
+        a, b = cylinder_cells(n)
+        yield f"cylinder {label}", *surfaces.cylinder_patch(radius=200.0, height=300.0, angle=180.0,
+                                                             n_around=a, n_along=b)
+
+
+def corpus_meshes(folder: Path):
+    """Yield ``(name, vertices, faces)`` for every ``*.obj`` and ``*.off`` in ``folder``.
+
+    Loaded with ``trimesh.load(path, process=False)``: vertices are neither merged
+    nor reordered.
+    """
+    paths = sorted(p for p in folder.iterdir() if p.suffix.lower() in (".obj", ".off"))
+    for path in paths:
+        mesh = trimesh.load(path, process=False)
+        vertices = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
+        faces = np.ascontiguousarray(mesh.faces, dtype=np.int64)
+        yield path.name, vertices, faces
+
+
+# --------------------------------------------------------------------------- #
+# Timing and measuring
+# --------------------------------------------------------------------------- #
+
+
+def best_of(fn, repeats: int):
+    """Call ``fn()`` ``repeats`` times; return ``(best seconds, result of the best run)``."""
+    best, result = np.inf, None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        dt = time.perf_counter() - t0
+        if dt < best:
+            best, result = dt, out
+    return best, result
+
+
+def measure(row: Row, vertices, faces, uv, loops) -> Row:
+    """Fill ``row`` with the strain, folds and overlap verdict of ``uv``.
+
+    Parameters
+    ----------
+    row : Row
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    uv : (n, 2) float64
+    loops : tuple of (k,) int64 or None
+        Boundary loops from :func:`patterns.validate_mesh`; without them the
+        one-to-one verdict is left empty.
+    """
+    if not np.all(np.isfinite(uv)):
+        row.note = (row.note + "; " if row.note else "") + "non-finite uv"
+        return row
+    with np.errstate(over="ignore", invalid="ignore"):
+        d = patterns.distortion(vertices, faces, uv, loops=loops)
+    row.rms, row.max, row.folds = d.edge_strain_rms, d.edge_strain_max, d.n_folded
+    if loops is not None:
+        row.one_to_one = patterns.overlap_verdict(faces, uv, loops).one_to_one
+    return row
+
+
+# --------------------------------------------------------------------------- #
+# patterns
+# --------------------------------------------------------------------------- #
+
+
+def run_patterns(name: str, vertices, faces, method: str, repeats: int,
+                 max_faces_conformal: int) -> Row:
+    """Time :func:`patterns.flatten_mesh` and measure its result.
+
+    Parameters
+    ----------
+    name : str
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    method : {"isometric", "conformal"}
+    repeats : int
+        Best of this many runs.
+    max_faces_conformal : int
+        Above this face count the conformal method is not run.
+
+    Returns
+    -------
+    Row
+        Strain from ``result.distortion``, folds and verdict from ``result``
+        (the same functions that measure the libigl rows).  A
+        :class:`patterns.PatternsError` is reported in the note ("diverged" for
+        a :class:`patterns.FlattenError`).
+    """
+    row = Row(name, len(faces), method)
+    if method == "conformal" and len(faces) > max_faces_conformal:
+        row.note = "skipped (pure-Python reference)"
+        return row
+    try:
+        seconds, result = best_of(lambda: patterns.flatten_mesh(vertices, faces, method=method, name=name),
+                                  repeats)
+    except patterns.FlattenError as exc:
+        row.note = f"diverged: {exc}"
+        return row
+    except patterns.PatternsError as exc:
+        row.note = f"{type(exc).__name__}: {exc}"
+        return row
+    row.seconds = seconds
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverged conformal layout overflows here
+        d = result.distortion
+    row.rms, row.max = d.edge_strain_rms, d.edge_strain_max
+    row.folds, row.one_to_one = result.n_folded, result.one_to_one
+    return row
+
+
+# --------------------------------------------------------------------------- #
+# libigl
+# --------------------------------------------------------------------------- #
+
+
+def farthest_boundary_pair(vertices: np.ndarray, boundary: np.ndarray) -> tuple[int, int]:
+    """The two boundary vertices farthest apart in 3D (exact, by blocks)."""
+    p = vertices[boundary]
+    best, pair = -1.0, (0, 1)
+    block = 1024
+    for start in range(0, len(p), block):
+        q = p[start:start + block]
+        d2 = (q * q).sum(1)[:, None] + (p * p).sum(1)[None, :] - 2.0 * q @ p.T
+        i, j = np.unravel_index(int(np.argmax(d2)), d2.shape)
+        if d2[i, j] > best:
+            best, pair = float(d2[i, j]), (start + int(i), int(j))
+    return int(boundary[pair[0]]), int(boundary[pair[1]])
+
+
+def igl_lscm(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """libigl LSCM with two boundary vertices pinned.
+
+    The two farthest-apart vertices of ``igl.boundary_loop`` are pinned at
+    ``(0, 0)`` and ``(d, 0)``, ``d`` their 3D distance.
+
+    Returns
+    -------
+    (n, 2) float64
+        The uv as libigl returns it (not yet area-normalised).
+    """
+    boundary = igl.boundary_loop(faces)
+    i, j = farthest_boundary_pair(vertices, boundary)
+    pins = np.array([i, j], dtype=np.int64)
+    pin_uv = np.array([[0.0, 0.0], [np.linalg.norm(vertices[j] - vertices[i]), 0.0]])
+    uv, _ = igl.lscm(vertices, faces, pins, pin_uv)
+    return uv
+
+
+def area_normalise(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> tuple[np.ndarray, float]:
+    """Scale ``uv`` by the one factor that makes its total area the 3D area.
+
+    The flat area is the sum of the unsigned triangle areas.
+
+    Returns
+    -------
+    uv : (n, 2) float64
+    factor : float
+    """
+    area_3d = patterns.distortion(vertices, faces, uv).area_3d
+    p = uv[faces]
+    a = p[:, 1] - p[:, 0]
+    b = p[:, 2] - p[:, 0]
+    area_flat = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum()
+    factor = float(np.sqrt(area_3d / area_flat))
+    return uv * factor, factor
+
+
+def igl_harmonic_init(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Harmonic map to the unit disk (boundary by arc length on the circle), as in libigl's tutorial."""
+    boundary = igl.boundary_loop(faces)
+    circle = igl.map_vertices_to_circle(vertices, boundary.astype(np.int32))
+    return igl.harmonic(vertices, faces, boundary, circle, 1)
+
+
+def igl_arap(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
+    """libigl ARAP parametrisation from the harmonic initialisation.
+
+    ``igl.arap_precomputation`` in 2D with the default ``igl.ARAPData``
+    (``max_iter`` 10, no dynamics) and one vertex (``faces[0, 0]``) held at its
+    initial position, then ``igl.arap_solve`` with the harmonic map as initial
+    guess.
+
+    Returns
+    -------
+    uv : (n, 2) float64
+    init : (n, 2) float64
+        The harmonic initialisation.
+    init_seconds : float
+        Time of the harmonic initialisation alone.
+    """
+    t0 = time.perf_counter()
+    init = igl_harmonic_init(vertices, faces)
+    init_seconds = time.perf_counter() - t0
+    # One vertex held where the initialisation put it.  The ARAP energy does not
+    # depend on translation, so this only removes the translation null space;
+    # with no fixed vertex at all, arap_precomputation fails on some meshes
+    # (the global step's matrix is then singular).
+    fixed = np.array([faces[0, 0]], dtype=np.int32)
+    data = igl.ARAPData()
+    igl.arap_precomputation(vertices, faces, 2, fixed, data)
+    uv = igl.arap_solve(init[fixed], data, init)
+    return uv, init, init_seconds
+
+
+def igl_slim(vertices: np.ndarray, faces: np.ndarray, iterations: int) -> tuple[np.ndarray, float]:
+    """libigl SLIM (symmetric Dirichlet, no constraints) from the harmonic initialisation.
+
+    Returns
+    -------
+    uv : (n, 2) float64
+    init : (n, 2) float64
+        The harmonic initialisation.
+    init_seconds : float
+        Time of the harmonic initialisation alone.
+    """
+    t0 = time.perf_counter()
+    init = igl_harmonic_init(vertices, faces)
+    init_seconds = time.perf_counter() - t0
+    data = igl.slim_precompute(
+        np.asfortranarray(vertices),
+        np.asfortranarray(faces, dtype=np.int32),
+        np.asfortranarray(init),
+        igl.MappingEnergyType.SYMMETRIC_DIRICHLET,
+        np.zeros(0, dtype=np.int32),
+        np.zeros((0, 2), order="F"),
+        0.0,
+    )
+    uv = igl.slim_solve(data, iterations)
+    return np.ascontiguousarray(uv), init, init_seconds
+
+
+def _mirror_if_reversed(faces: np.ndarray, uv: np.ndarray, row: Row) -> np.ndarray:
+    """Mirror a libigl uv whose total signed area is negative (a reflected layout), and say so."""
+    p = uv[faces]
+    a = p[:, 1] - p[:, 0]
+    b = p[:, 2] - p[:, 0]
+    if np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) < 0:
+        row.note = (row.note + "; " if row.note else "") + "mirrored (libigl output was reflected)"
+        return uv * np.array([-1.0, 1.0])
+    return uv
+
+
+def _init_note(faces: np.ndarray, init: np.ndarray, init_seconds: float) -> str:
+    """Note on the harmonic initialisation: its time and, if any, its folded triangles."""
+    folded = len(folded_faces(faces, init))
+    return f"harmonic init {init_seconds:.3f} s" + (f" ({folded} folded)" if folded else "")
+
+
+def run_libigl(name: str, vertices, faces, method: str, repeats: int, loops, max_faces_slim: int) -> Row:
+    """Time one libigl method and measure its (for LSCM: area-normalised) result.
+
+    Parameters
+    ----------
+    name : str
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    method : {"lscm", "arap", "slim"}
+    repeats : int
+    loops : tuple of (k,) int64 or None
+        Boundary loops for the overlap verdict.
+    max_faces_slim : int
+        Above this face count SLIM is not run.
+
+    Returns
+    -------
+    Row
+    """
+    row = Row(name, len(faces), method)
+    if method == "slim" and len(faces) > max_faces_slim:
+        row.note = f"skipped (> {max_faces_slim} faces)"
+        return row
+    try:
+        if method == "lscm":
+            seconds, uv = best_of(lambda: igl_lscm(vertices, faces), repeats)
+        elif method == "arap":
+            seconds, (uv, init, init_seconds) = best_of(lambda: igl_arap(vertices, faces), repeats)
+            row.note = _init_note(faces, init, init_seconds)
+        elif method == "slim":
+            seconds, (uv, init, init_seconds) = best_of(
+                lambda: igl_slim(vertices, faces, SLIM_ITERATIONS), repeats)
+            row.note = _init_note(faces, init, init_seconds) + f"; {SLIM_ITERATIONS} iterations"
+        else:
+            raise ValueError(method)
+    except (RuntimeError, ValueError, TypeError, MemoryError) as exc:  # reported in the row
+        row.note = f"failed: {type(exc).__name__}: {exc}"
+        return row
+    row.seconds = seconds
+    uv = np.asarray(uv, dtype=np.float64)
+    if np.all(np.isfinite(uv)):
+        uv = _mirror_if_reversed(faces, uv, row)
+        if method == "lscm":
+            uv, factor = area_normalise(vertices, faces, uv)
+            row.note = (row.note + "; " if row.note else "") + f"uv x {factor:.4g} (area-normalised)"
+    return measure(row, vertices, faces, uv, loops)
+
+
+# --------------------------------------------------------------------------- #
+# Driver
+# --------------------------------------------------------------------------- #
+
+
+def bench_mesh(name: str, vertices, faces, methods, args, on_row) -> list[Row]:
+    """Run every selected method on one mesh; return its rows in print order.
+
+    LSCM runs first so the other rows can be given as a ratio of its time.
+    ``on_row(row, lscm_seconds)`` is called as each row is finished.
+    """
+    n_faces = len(faces)
+    repeats = 3 if n_faces <= REPEAT_LIMIT else 1
+    try:
+        loops = patterns.validate_mesh(vertices, faces, name=name)[2].loops
+        loops_note = ""
+    except patterns.PatternsError as exc:
+        loops = None
+        loops_note = f"validate_mesh: {type(exc).__name__}: {exc}"
+    rows = {}
+    order = ["lscm"] + [m for m in ALL_METHODS if m != "lscm"]
+    for method in order:
+        if method not in methods:
+            continue
+        print(f"  {name}: {method} ...", file=sys.stderr, flush=True)
+        if method in patterns.METHODS:
+            rows[method] = run_patterns(name, vertices, faces, method, repeats, args.max_faces_conformal)
+        else:
+            rows[method] = run_libigl(name, vertices, faces, method, repeats, loops, args.max_faces_slim)
+            if loops is None and not rows[method].note.startswith("skipped"):
+                rows[method].note = "; ".join(x for x in (rows[method].note, loops_note) if x)
+    out = [rows[m] for m in ALL_METHODS if m in rows]
+    lscm = rows["lscm"].seconds if "lscm" in rows else None
+    for row in out:
+        on_row(row, lscm)
+    return out
+
+
+def warm_up(methods) -> None:
+    """Run every selected method once on a small disk, untimed (imports, first-call set-up)."""
+    vertices, faces = surfaces.spherical_cap(radius=100.0, half_angle=30.0, n_faces=600)
+    loops = patterns.validate_mesh(vertices, faces)[2].loops
+    for method in methods:
+        if method in patterns.METHODS:
+            run_patterns("warm-up", vertices, faces, method, 1, len(faces))
+        else:
+            run_libigl("warm-up", vertices, faces, method, 1, loops, len(faces))
+
+
+HEADER = """\
+Edge strain = |flat edge length / 3D edge length - 1| over all edges (RMS and max, in %).
+Times: best of 3 runs up to {limit} faces, 1 run above; '/ LSCM' = seconds / LSCM seconds on the same mesh.
+isometric, conformal: patterns.flatten_mesh (validation + grower + overlap verdict), uv never rescaled.
+lscm: igl.lscm, two farthest boundary vertices pinned; its uv is RESCALED by one factor so that
+  total flat area = total 3D area before the strain is measured (LSCM has no scale of its own).
+arap: igl harmonic init (boundary on a circle) + arap_precomputation/arap_solve, 2D, default 10 iterations,
+  one vertex held (translation only); time includes the harmonic init.
+slim: igl.slim_solve, symmetric Dirichlet, {slim} iterations, same harmonic init, included in the time.
+All rows measured by patterns.distortion and patterns.overlap_verdict (outside the timed region)."""
+
+
+def main(argv=None) -> int:
+    """Command-line entry point; see ``--help``."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--sizes", default="1k,10k,100k,1M",
+                        help="generated surface sizes, comma-separated from 1k,10k,100k,1M "
+                             "(default all; '' for none)")
+    parser.add_argument("--no-corpus", action="store_true", help="skip the shared corpus meshes")
+    parser.add_argument("--methods", default=",".join(ALL_METHODS),
+                        help=f"comma-separated subset of {','.join(ALL_METHODS)} (default all)")
+    parser.add_argument("--markdown", action="store_true",
+                        help="print the tables as markdown (for docs/benchmarks.md) at the end")
+    parser.add_argument("--max-faces-conformal", type=int, default=200_000,
+                        help="skip the conformal method above this many faces (default 200000)")
+    parser.add_argument("--max-faces-slim", type=int, default=120_000,
+                        help="skip libigl SLIM above this many faces (default 120000)")
+    args = parser.parse_args(argv)
+
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    unknown = [m for m in methods if m not in ALL_METHODS]
+    if unknown:
+        parser.error(f"unknown methods {unknown}; choose from {', '.join(ALL_METHODS)}")
+    sizes = parse_sizes(args.sizes)
+
+    print(HEADER.format(limit=REPEAT_LIMIT, slim=SLIM_ITERATIONS))
+    print()
+
+    def on_row(row, lscm):
+        # With --markdown the tables come at the end; the rows go to stderr as progress.
+        print(plain_line(_cells(row, lscm)), file=sys.stderr if args.markdown else sys.stdout, flush=True)
+
+    sections = []
+    if args.no_corpus:
+        print("corpus: skipped (--no-corpus)")
+    elif not CORPUS.is_dir():
+        print(f"corpus: skipped ({CORPUS} does not exist)")
+    else:
+        sections.append((f"Corpus ({CORPUS.name}/)", corpus_meshes(CORPUS)))
+    if sizes:
+        sections.append(("Generated surfaces", generated_meshes(sizes)))
+
+    warm_up(methods)
+    tables = []
+    for title, meshes in sections:
+        if not args.markdown:
+            print(f"\n== {title} ==")
+            print(plain_line(COLUMNS))
+        groups = []
+        for name, vertices, faces in meshes:
+            groups.append(bench_mesh(name, vertices, faces, methods, args, on_row))
+        tables.append((title, groups))
+
+    if args.markdown:
+        for title, groups in tables:
+            print(f"\n### {title}\n")
+            print(markdown_table(groups))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

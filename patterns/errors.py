@@ -1,0 +1,47 @@
+"""The exception tree of `patterns`.
+
+Every error a user can cause is a :class:`PatternsError`.  Each class is also the
+builtin exception a Python programmer would expect (``InputError`` is a
+``ValueError``, ``ExportError`` an ``OSError``), so ``except ValueError`` keeps
+working in code that does not know about `patterns`.
+
+Geometry findings (strain over a limit, an overlap) are *not* exceptions: they are
+reported on the result.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "PatternsError",
+    "InputError",
+    "MeshTopologyError",
+    "CadError",
+    "FlattenError",
+    "ExportError",
+]
+
+
+class PatternsError(Exception):
+    """Base class of every error raised by `patterns`."""
+
+
+class InputError(PatternsError, ValueError):
+    """Bad input: wrong array shape, NaN/inf coordinates, out-of-range indices,
+    degenerate faces, an option out of range."""
+
+
+class MeshTopologyError(InputError):
+    """A mesh whose topology cannot be flattened as given: closed, non-manifold,
+    several pieces, inconsistently wound, or not a planar domain."""
+
+
+class CadError(PatternsError):
+    """An unreadable or empty CAD file, or a tessellation that failed."""
+
+
+class FlattenError(PatternsError):
+    """The flattening could not be completed within the limits asked for."""
+
+
+class ExportError(PatternsError, OSError):
+    """An output file could not be written."""

@@ -1,0 +1,247 @@
+"""Distortion of a flattening: stretches, strains, areas, boundary lengths.
+
+Every function takes the 3D mesh ``vertices : (n, 3) float64`` and
+``faces : (m, 3) int64`` and the flat positions ``uv : (n, 2) float64`` in the
+same unit (mm), and returns plain arrays; :func:`distortion` gathers the usual
+summary in one frozen :class:`Distortion`.
+
+The per-triangle map from the surface to the plane is affine; its Jacobian ``J``
+(2 x 2, in each triangle's own orthonormal frame) has singular values
+``sigma1 >= sigma2``: the principal stretches.  An isometry has
+``sigma1 = sigma2 = 1``; ``sigma - 1`` are the principal strains; ``det J < 0``
+(or a zero flat area) is a folded, i.e. flipped or collapsed, triangle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "Distortion",
+    "local_coordinates",
+    "affine_coefficients",
+    "principal_stretches",
+    "signed_areas",
+    "folded_faces",
+    "edge_strain",
+    "area_ratio",
+    "boundary_lengths",
+    "distortion",
+]
+
+
+def local_coordinates(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Each triangle in its own orthonormal frame (Li & Xue, eqs. 4-6).
+
+    With ``A = p2 - p1``, ``B = p3 - p1``, ``N = A x B / |A x B|``,
+    ``X = N x B / |N x B|`` and ``Y = N x X``, the corners are
+    ``(0, 0)``, ``(A.X, A.Y)`` and ``(B.X, B.Y)``: an isometric copy of the
+    triangle, counter-clockwise when the triangle is counter-clockwise about ``N``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+
+    Returns
+    -------
+    (m, 3) complex128
+        Corner ``k`` of face ``f`` is ``x + iy`` in the face's frame, same unit as
+        ``vertices``.
+    """
+    p = vertices[faces]
+    a = p[:, 1] - p[:, 0]
+    b = p[:, 2] - p[:, 0]
+    n = np.cross(a, b)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    x = np.cross(n, b)
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    y = np.cross(n, x)
+    z = np.zeros((len(faces), 3), dtype=np.complex128)
+    z[:, 1] = np.einsum("ij,ij->i", a, x) + 1j * np.einsum("ij,ij->i", a, y)
+    z[:, 2] = np.einsum("ij,ij->i", b, x) + 1j * np.einsum("ij,ij->i", b, y)
+    return z
+
+
+def affine_coefficients(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The per-triangle map as ``w = alpha z + beta conj(z) + c`` in complex form.
+
+    Returns
+    -------
+    alpha, beta : (m,) complex128
+        ``|alpha| + |beta|`` and ``||alpha| - |beta||`` are the principal
+        stretches; ``|alpha|**2 - |beta|**2`` is ``det J`` (flat area over 3D area).
+    """
+    z = local_coordinates(vertices, faces)
+    w = uv[faces, 0] + 1j * uv[faces, 1]
+    e1, e2 = z[:, 1] - z[:, 0], z[:, 2] - z[:, 0]
+    w1, w2 = w[:, 1] - w[:, 0], w[:, 2] - w[:, 0]
+    d = e1 * np.conj(e2) - e2 * np.conj(e1)
+    alpha = (w1 * np.conj(e2) - w2 * np.conj(e1)) / d
+    beta = (e1 * w2 - e2 * w1) / d
+    return alpha, beta
+
+
+def principal_stretches(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Principal stretches of the surface-to-plane map, per triangle.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    uv : (n, 2) float64
+        Flat positions, same unit as ``vertices``.
+
+    Returns
+    -------
+    (m, 2) float64
+        ``sigma1 >= sigma2 >= 0`` (dimensionless); 1 is no stretch.
+    """
+    alpha, beta = affine_coefficients(vertices, faces, uv)
+    a, b = np.abs(alpha), np.abs(beta)
+    return np.stack([a + b, np.abs(a - b)], axis=1)
+
+
+def signed_areas(faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Signed flat areas ``(m,) float64`` (positive = counter-clockwise)."""
+    p = uv[faces]
+    a = p[:, 1] - p[:, 0]
+    b = p[:, 2] - p[:, 0]
+    return 0.5 * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+
+
+def folded_faces(faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Indices ``(k,) int64`` of the triangles whose flat signed area is <= 0."""
+    return np.flatnonzero(~(signed_areas(faces, uv) > 0))
+
+
+def _unique_edges(faces: np.ndarray) -> np.ndarray:
+    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    e.sort(axis=1)
+    return np.unique(e, axis=0)
+
+
+def edge_strain(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, edges: np.ndarray | None = None) -> np.ndarray:
+    """Edge strain ``|l_flat / l_3d - 1|`` of every edge.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    uv : (n, 2) float64
+    edges : (e, 2) int64, optional
+        The unique edges (computed from ``faces`` when omitted).
+
+    Returns
+    -------
+    (e,) float64, dimensionless, in the order of ``edges`` (sorted unique edges
+    when computed here).
+    """
+    if edges is None:
+        edges = _unique_edges(faces)
+    l3 = np.linalg.norm(vertices[edges[:, 1]] - vertices[edges[:, 0]], axis=1)
+    l2 = np.linalg.norm(uv[edges[:, 1]] - uv[edges[:, 0]], axis=1)
+    return np.abs(l2 / l3 - 1.0)
+
+
+def area_ratio(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Signed flat area over 3D area, per triangle ``(m,) float64``."""
+    p = vertices[faces]
+    a3 = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    return signed_areas(faces, uv) / a3
+
+
+def boundary_lengths(vertices: np.ndarray, uv: np.ndarray, loops) -> np.ndarray:
+    """Length of each boundary loop on the surface and in the plane.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    uv : (n, 2) float64
+    loops : sequence of (k,) int64 arrays
+        Closed vertex loops (see :func:`patterns.mesh.boundary_loops`).
+
+    Returns
+    -------
+    (len(loops), 2) float64
+        Columns: 3D length, flat length (unit of ``vertices``).
+    """
+    out = np.empty((len(loops), 2))
+    for i, loop in enumerate(loops):
+        nxt = np.roll(loop, -1)
+        out[i, 0] = np.linalg.norm(vertices[nxt] - vertices[loop], axis=1).sum()
+        out[i, 1] = np.linalg.norm(uv[nxt] - uv[loop], axis=1).sum()
+    return out
+
+
+@dataclass(frozen=True)
+class Distortion:
+    """Summary of how far a flattening is from an isometry.
+
+    All strains are dimensionless (0.01 = 1 %); lengths and areas in the mesh unit.
+    """
+
+    edge_strain_rms: float
+    edge_strain_max: float
+    stretch_min: float
+    """Smallest principal stretch over all triangles (sigma2)."""
+    stretch_max: float
+    """Largest principal stretch over all triangles (sigma1)."""
+    area_3d: float
+    area_flat: float
+    """Sum of signed flat areas (folded triangles count negative)."""
+    n_folded: int
+    boundary_3d: float
+    """Total length of all boundary loops on the surface."""
+    boundary_flat: float
+
+    @property
+    def area_ratio(self) -> float:
+        return self.area_flat / self.area_3d
+
+
+def distortion(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, loops=None) -> Distortion:
+    """Summarise the distortion of ``uv`` as a flattening of ``(vertices, faces)``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    uv : (n, 2) float64
+    loops : sequence of (k,) int64 arrays, optional
+        Boundary loops; when omitted the boundary lengths are reported as NaN.
+
+    Returns
+    -------
+    Distortion
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    uv = np.asarray(uv, dtype=np.float64)
+    # A diverged flattening (the paper's method on a fine mesh) overflows: its
+    # measures are honestly inf, without warnings.
+    with np.errstate(over="ignore", invalid="ignore"):
+        strain = edge_strain(vertices, faces, uv)
+        sigma = principal_stretches(vertices, faces, uv)
+        p = vertices[faces]
+        a3 = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+        sa = signed_areas(faces, uv)
+        if loops is None:
+            b3 = bf = float("nan")
+        else:
+            lengths = boundary_lengths(vertices, uv, loops)
+            b3, bf = (float(x) for x in lengths.sum(axis=0))
+        rms = float(np.sqrt(np.mean(strain**2)))
+    return Distortion(
+        edge_strain_rms=rms,
+        edge_strain_max=float(strain.max()),
+        stretch_min=float(sigma[:, 1].min()),
+        stretch_max=float(sigma[:, 0].max()),
+        area_3d=float(a3.sum()),
+        area_flat=float(sa.sum()),
+        n_folded=int(np.count_nonzero(~(sa > 0))),
+        boundary_3d=b3,
+        boundary_flat=bf,
+    )

@@ -1,0 +1,321 @@
+"""Pure functions on triangle meshes given as plain arrays.
+
+A mesh is ``vertices : (n, 3) float64`` (millimetres, or whatever unit the caller
+uses: nothing here rescales) and ``faces : (m, 3) int64`` (indices into
+``vertices``, counter-clockwise seen from the side the normal points to).
+
+:func:`validate_mesh` checks a mesh once and returns its :class:`Connectivity`,
+the edge and adjacency tables every later stage reuses.  Nothing here merges,
+reorders or repairs vertices silently: a mesh that cannot be used as given is
+refused with a :class:`~patterns.errors.InputError` or
+:class:`~patterns.errors.MeshTopologyError` that names the problem.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse import csgraph
+
+from .errors import InputError, MeshTopologyError
+
+__all__ = [
+    "Connectivity",
+    "validate_mesh",
+    "as_mesh_arrays",
+    "boundary_loops",
+    "face_areas",
+]
+
+
+def _readonly(array: np.ndarray) -> np.ndarray:
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class Connectivity:
+    """Edge and adjacency tables of a validated mesh (read-only arrays).
+
+    Attributes
+    ----------
+    n_vertices : int
+    edges : (e, 2) int64
+        Unique undirected edges, ``edges[:, 0] < edges[:, 1]``.
+    face_edges : (m, 3) int64
+        ``face_edges[f, k]`` is the edge from corner ``k`` to corner ``k + 1`` of
+        face ``f``.
+    edge_faces : (e, 2) int64
+        The faces on either side of each edge; ``-1`` on the boundary side.
+    vertex_faces_ptr, vertex_faces : (n + 1,) int64, (3 m,) int64
+        CSR table of the faces incident to each vertex.
+    loops : tuple of (k,) int64 arrays
+        Boundary loops as vertex indices, oriented so that the surface lies to
+        their left (the outer loop of a planar domain runs counter-clockwise).
+    """
+
+    n_vertices: int
+    edges: np.ndarray
+    face_edges: np.ndarray
+    edge_faces: np.ndarray
+    vertex_faces_ptr: np.ndarray
+    vertex_faces: np.ndarray
+    loops: tuple
+
+    @property
+    def boundary_edges(self) -> np.ndarray:
+        """(b,) int64: indices of the edges with a face on one side only."""
+        return np.flatnonzero(self.edge_faces[:, 1] < 0)
+
+
+def as_mesh_arrays(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, np.ndarray]:
+    """Convert to ``(float64 (n, 3), int64 (m, 3))`` arrays, checking shape and values.
+
+    Parameters
+    ----------
+    vertices : array_like, (n, 3)
+        Coordinates; must all be finite.
+    faces : array_like, (m, 3)
+        Integer vertex indices in ``[0, n)``.
+    name : str
+        How the mesh is named in error messages (a file name, a panel name).
+
+    Returns
+    -------
+    vertices : (n, 3) float64 ndarray (a copy)
+    faces : (m, 3) int64 ndarray (a copy)
+
+    Raises
+    ------
+    InputError
+        On a wrong shape, NaN/inf coordinates, non-integer or out-of-range indices.
+    """
+    try:
+        v = np.array(vertices, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: vertices are not numbers ({exc})") from None
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise InputError(f"{name}: vertices must have shape (n, 3), got {v.shape}")
+    f_raw = np.asarray(faces)
+    if f_raw.ndim != 2 or f_raw.shape[1] != 3:
+        raise InputError(f"{name}: faces must have shape (m, 3), got {f_raw.shape}")
+    if f_raw.size and not np.issubdtype(f_raw.dtype, np.integer):
+        if not np.issubdtype(f_raw.dtype, np.floating) or not np.all(np.isfinite(f_raw)) \
+                or np.any(f_raw != np.round(f_raw)):
+            raise InputError(f"{name}: face indices must be integers")
+    f = f_raw.astype(np.int64, copy=True)
+    if len(f) == 0:
+        raise InputError(f"{name}: the mesh has no faces")
+    bad = ~np.isfinite(v).all(axis=1)
+    if bad.any():
+        raise InputError(
+            f"{name}: {int(bad.sum())} vertices have NaN or infinite coordinates "
+            f"(first: vertex {int(np.flatnonzero(bad)[0])})"
+        )
+    out = (f < 0) | (f >= len(v))
+    if out.any():
+        row = int(np.flatnonzero(out.any(axis=1))[0])
+        raise InputError(
+            f"{name}: {int(out.any(axis=1).sum())} faces index vertices outside [0, {len(v)}) "
+            f"(first: face {row} = {f[row].tolist()})"
+        )
+    return v, f
+
+
+def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Areas of the triangles.
+
+    Parameters
+    ----------
+    vertices : (n, 3) or (n, 2) float64
+    faces : (m, 3) int64
+
+    Returns
+    -------
+    (m,) float64, in the square of the vertices' unit (unsigned).
+    """
+    p = vertices[faces]
+    a = p[:, 1] - p[:, 0]
+    b = p[:, 2] - p[:, 0]
+    if vertices.shape[1] == 2:
+        return 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    return 0.5 * np.linalg.norm(np.cross(a, b), axis=1)
+
+
+def validate_mesh(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, np.ndarray, Connectivity]:
+    """Check that a mesh is a connected, consistently wound planar domain.
+
+    A planar domain is a surface that can be laid flat without cutting: a disk,
+    or a disk with holes (any number of boundary loops, genus 0).
+
+    Parameters
+    ----------
+    vertices : array_like, (n, 3)
+    faces : array_like, (m, 3)
+    name : str
+        Used in error messages.
+
+    Returns
+    -------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    connectivity : Connectivity
+
+    Raises
+    ------
+    InputError
+        Bad arrays (see :func:`as_mesh_arrays`), degenerate (zero-area) faces,
+        vertices used by no face.
+    MeshTopologyError
+        Non-manifold edges or vertices, inconsistent winding, several pieces, a
+        closed surface, or a surface with handles (genus > 0).
+    """
+    v, f = as_mesh_arrays(vertices, faces, name=name)
+    n, m = len(v), len(f)
+
+    repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
+    area = face_areas(v, f)
+    scale = float(np.ptp(v, axis=0).max()) if n else 0.0
+    degenerate = repeated | (area <= (1e-14 * scale) ** 2 * 0.5) | ~np.isfinite(area)
+    if degenerate.any():
+        raise InputError(
+            f"{name}: {int(degenerate.sum())} degenerate (zero-area) faces "
+            f"(first: face {int(np.flatnonzero(degenerate)[0])})"
+        )
+    used = np.zeros(n, dtype=bool)
+    used[f.ravel()] = True
+    if not used.all():
+        raise InputError(
+            f"{name}: {int((~used).sum())} vertices are used by no face "
+            f"(first: vertex {int(np.flatnonzero(~used)[0])}); remove them first"
+        )
+
+    # Half-edges k: corner k -> corner k+1 of each face.
+    a = f.ravel()
+    b = f[:, [1, 2, 0]].ravel()
+    lo = np.minimum(a, b)
+    hi = np.maximum(a, b)
+    keys = lo * n + hi
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    first = np.ones(len(keys), dtype=bool)
+    first[1:] = sorted_keys[1:] != sorted_keys[:-1]
+    starts = np.flatnonzero(first)
+    counts = np.diff(np.append(starts, len(keys)))
+    edge_id_sorted = np.cumsum(first) - 1
+    face_edges = np.empty(len(keys), dtype=np.int64)
+    face_edges[order] = edge_id_sorted
+    face_edges = face_edges.reshape(m, 3)
+    edges = np.stack([lo[order[starts]], hi[order[starts]]], axis=1)
+
+    if (counts > 2).any():
+        e = int(np.flatnonzero(counts > 2)[0])
+        raise MeshTopologyError(
+            f"{name}: {int((counts > 2).sum())} non-manifold edges shared by more than two faces "
+            f"(first: edge {edges[e].tolist()}, {int(counts[e])} faces)"
+        )
+    # Each interior edge must be used once in each direction.
+    forward = (a < b)[order]
+    interior = counts == 2
+    fwd_sum = np.add.reduceat(forward.astype(np.int64), starts)
+    bad_winding = interior & (fwd_sum != 1)
+    if bad_winding.any():
+        e = int(np.flatnonzero(bad_winding)[0])
+        raise MeshTopologyError(
+            f"{name}: faces are not consistently wound ({int(bad_winding.sum())} edges are "
+            f"used twice in the same direction, first: edge {edges[e].tolist()}); "
+            f"orient the faces consistently first"
+        )
+
+    face_of = order // 3
+    edge_faces = np.full((len(edges), 2), -1, dtype=np.int64)
+    edge_faces[:, 0] = face_of[starts]
+    edge_faces[interior, 1] = face_of[starts[interior] + 1]
+
+    # Pieces: faces joined through shared edges.
+    pairs = edge_faces[interior]
+    adjacency = sp.coo_matrix(
+        (np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(m, m)
+    )
+    n_pieces, _ = csgraph.connected_components(adjacency, directed=False)
+    if n_pieces > 1:
+        raise MeshTopologyError(
+            f"{name}: the mesh has {n_pieces} disconnected pieces; flatten each piece on its own"
+        )
+
+    boundary = ~interior
+    if not boundary.any():
+        raise MeshTopologyError(
+            f"{name}: the surface is closed (no boundary edge); cut it open along a seam first"
+        )
+    # Directed boundary edges, oriented with the surface to their left.
+    bh = order[starts[boundary]]
+    b_from, b_to = a[bh], b[bh]
+    out_degree = np.bincount(b_from, minlength=n)
+    if (out_degree > 1).any():
+        vtx = int(np.flatnonzero(out_degree > 1)[0])
+        raise MeshTopologyError(
+            f"{name}: non-manifold vertex {vtx} (the boundary passes through it "
+            f"{int(out_degree[vtx])} times); split it first"
+        )
+    loops = _trace_loops(b_from, b_to, n)
+
+    chi = n - len(edges) + m
+    genus2 = 2 - len(loops) - chi
+    if genus2 != 0:
+        raise MeshTopologyError(
+            f"{name}: the surface has handles (Euler characteristic {chi} with "
+            f"{len(loops)} boundary loops, genus {genus2 / 2:g}); cut it into disks first"
+        )
+
+    vf_order = np.argsort(f.ravel(), kind="stable")
+    vf_ptr = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(f.ravel(), minlength=n), out=vf_ptr[1:])
+    connectivity = Connectivity(
+        n_vertices=n,
+        edges=_readonly(edges),
+        face_edges=_readonly(face_edges),
+        edge_faces=_readonly(edge_faces),
+        vertex_faces_ptr=_readonly(vf_ptr),
+        vertex_faces=_readonly(vf_order // 3),
+        loops=tuple(_readonly(loop) for loop in loops),
+    )
+    return v, f, connectivity
+
+
+def _trace_loops(b_from: np.ndarray, b_to: np.ndarray, n: int) -> list[np.ndarray]:
+    """Chain directed boundary edges (each vertex starts at most one) into loops."""
+    succ = np.full(n, -1, dtype=np.int64)
+    succ[b_from] = b_to
+    seen = np.zeros(n, dtype=bool)
+    loops = []
+    for start in b_from:
+        if seen[start]:
+            continue
+        loop = [start]
+        seen[start] = True
+        nxt = succ[start]
+        while nxt != start:
+            if nxt < 0 or seen[nxt]:  # pragma: no cover - excluded by the degree check
+                raise MeshTopologyError("boundary edges do not form closed loops")
+            loop.append(nxt)
+            seen[nxt] = True
+            nxt = succ[nxt]
+        loops.append(np.asarray(loop, dtype=np.int64))
+    # Longest loop first: the usual outer boundary of a panel.
+    loops.sort(key=len, reverse=True)
+    return loops
+
+
+def boundary_loops(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, ...]:
+    """Boundary loops of a planar-domain mesh.
+
+    Returns
+    -------
+    tuple of (k,) int64 arrays
+        Vertex indices of each loop, the surface to the left of the walking
+        direction; the longest loop (by vertex count) first.
+    """
+    return validate_mesh(vertices, faces, name=name)[2].loops

@@ -1,0 +1,25 @@
+"""Helpers shared by the tests (independent of the code under test)."""
+
+import numpy as np
+
+
+def random_rotation(rng: np.random.Generator) -> np.ndarray:
+    """A uniformly random proper rotation (3, 3)."""
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q *= np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] *= -1
+    return q
+
+
+def rigid_fit_residual(a: np.ndarray, b: np.ndarray) -> float:
+    """Largest distance left after the best 2D rigid motion (no scaling) of ``a`` onto ``b``.
+
+    Independent of the code under test: Kabsch/Procrustes by SVD.
+    """
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    h = (a - ca).T @ (b - cb)
+    u, _, vt = np.linalg.svd(h)
+    d = np.sign(np.linalg.det(vt.T @ u.T))
+    rot = vt.T @ np.diag([1.0, d]) @ u.T
+    return float(np.abs((a - ca) @ rot.T - (b - cb)).max())

@@ -1,0 +1,122 @@
+"""Mesh validation: every way a mesh can be unusable gets its own clear error."""
+
+import numpy as np
+import pytest
+
+import patterns
+from patterns import surfaces
+from patterns.errors import InputError, MeshTopologyError
+from patterns.mesh import validate_mesh
+
+SQUARE_V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float)
+SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def test_square_is_valid_and_its_loop_runs_counter_clockwise():
+    v, f, conn = validate_mesh(SQUARE_V, SQUARE_F)
+    assert len(conn.edges) == 5
+    assert len(conn.loops) == 1
+    assert conn.loops[0].tolist() in ([0, 1, 2, 3], [1, 2, 3, 0], [2, 3, 0, 1], [3, 0, 1, 2])
+    assert (conn.edge_faces[:, 1] < 0).sum() == 4
+
+
+@pytest.mark.parametrize(
+    ("vertices", "faces", "error", "words"),
+    [
+        (SQUARE_V[:, :2], SQUARE_F, InputError, "shape (n, 3)"),
+        (SQUARE_V, SQUARE_F[:, :2], InputError, "shape (m, 3)"),
+        (np.where(np.arange(12).reshape(4, 3) == 4, np.nan, SQUARE_V), SQUARE_F, InputError, "NaN or infinite"),
+        (np.where(np.arange(12).reshape(4, 3) == 7, np.inf, SQUARE_V), SQUARE_F, InputError, "vertex 2"),
+        (SQUARE_V, np.array([[0, 1, 2], [0, 2, 4]]), InputError, "outside [0, 4)"),
+        (SQUARE_V, np.array([[0, 1, 2], [0, 2, -1]]), InputError, "outside [0, 4)"),
+        (SQUARE_V, np.array([[0, 1, 2], [0, 2, 2]]), InputError, "degenerate"),
+        (np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]], float), np.array([[0, 1, 2], [0, 1, 3]]),
+         InputError, "degenerate"),
+        (np.vstack([SQUARE_V, [[5, 5, 5]]]), SQUARE_F, InputError, "used by no face"),
+        (SQUARE_V, np.array([[0, 1, 2], [0, 3, 2]]), MeshTopologyError, "consistently wound"),
+        (SQUARE_V, np.zeros((0, 3), int), InputError, "no faces"),
+        (SQUARE_V, np.array([[0, 1, 2], [0, 2, 3.5]]), InputError, "integers"),
+    ],
+)
+def test_bad_arrays_raise_one_clear_error(vertices, faces, error, words):
+    with pytest.raises(error, match=None) as info:
+        validate_mesh(vertices, faces, name="part.obj")
+    assert words in str(info.value)
+    assert str(info.value).startswith("part.obj: ") or "faces" in str(info.value)
+
+
+def test_errors_are_builtin_value_errors_too():
+    with pytest.raises(ValueError):
+        validate_mesh(SQUARE_V[:, :2], SQUARE_F)
+    assert issubclass(MeshTopologyError, patterns.PatternsError)
+
+
+def test_non_manifold_edge():
+    v = np.vstack([SQUARE_V, [[0.5, 0.5, 1.0]]])
+    f = np.array([[0, 1, 2], [0, 2, 3], [0, 4, 2]])  # edge 0-2 in three faces
+    with pytest.raises(MeshTopologyError, match="non-manifold edges"):
+        validate_mesh(v, f)
+
+
+def test_disconnected_pieces():
+    v = np.vstack([SQUARE_V, SQUARE_V + [3, 0, 0]])
+    f = np.vstack([SQUARE_F, SQUARE_F + 4])
+    with pytest.raises(MeshTopologyError, match="2 disconnected pieces"):
+        validate_mesh(v, f)
+
+
+def test_two_triangles_touching_at_a_vertex_are_two_pieces():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], float)
+    f = np.array([[0, 1, 2], [0, 3, 4]])
+    with pytest.raises(MeshTopologyError, match="disconnected"):
+        validate_mesh(v, f)
+
+
+def test_pinched_vertex_is_non_manifold():
+    # Glue two opposite rim vertices of a disk: the boundary passes twice through one vertex.
+    p, f = surfaces.disk_mesh(100)
+    v = np.column_stack([p, np.zeros(len(p))])
+    rim = np.flatnonzero(np.isclose(np.linalg.norm(p, axis=1), 1.0))
+    a, b = rim[0], rim[len(rim) // 2]
+    f = np.where(f == b, a, f)
+    f = np.where(f > b, f - 1, f)
+    v = np.delete(v, b, axis=0)
+    with pytest.raises(MeshTopologyError, match=f"non-manifold vertex {a}"):
+        validate_mesh(v, f)
+
+
+def test_closed_surface():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    f = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    with pytest.raises(MeshTopologyError, match="closed"):
+        validate_mesh(v, f)
+
+
+def test_handle_is_refused():
+    # A torus with one face removed: genus 1, one boundary loop.
+    n, k = 8, 6
+    i, j = np.meshgrid(np.arange(n), np.arange(k), indexing="ij")
+    a = 2 * np.pi * i.ravel() / n
+    b = 2 * np.pi * j.ravel() / k
+    v = np.column_stack([(3 + np.cos(b)) * np.cos(a), (3 + np.cos(b)) * np.sin(a), np.sin(b)])
+    idx = (i * k + j)
+    p, q = idx, np.roll(idx, -1, axis=0)
+    r, s = np.roll(idx, -1, axis=1), np.roll(np.roll(idx, -1, axis=0), -1, axis=1)
+    f = np.concatenate([np.stack([p.ravel(), q.ravel(), s.ravel()], 1), np.stack([p.ravel(), s.ravel(), r.ravel()], 1)])
+    with pytest.raises(MeshTopologyError, match="handles"):
+        validate_mesh(v, f[1:])
+
+
+def test_holes_give_one_loop_each_with_the_outer_loop_first():
+    v, f = surfaces.disk_mesh(3000)
+    v3 = np.column_stack([v, np.zeros(len(v))])
+    # Cut two holes: drop the faces whose centroid lies in two small disks.
+    c = v[f].mean(axis=1)
+    keep = (np.linalg.norm(c - [0.4, 0], axis=1) > 0.15) & (np.linalg.norm(c - [-0.4, 0.1], axis=1) > 0.2)
+    f = f[keep]
+    used = np.unique(f)
+    remap = np.full(len(v3), -1)
+    remap[used] = np.arange(len(used))
+    _, _, conn = validate_mesh(v3[used], remap[f])
+    assert len(conn.loops) == 3
+    assert len(conn.loops[0]) == 6 * int(round(np.sqrt(3000 / 6)))  # the rim ring
