@@ -38,7 +38,8 @@ class MeshFile:
     n_welded : int
         Vertices merged into another at the same coordinates.
     n_unused : int
-        Vertices that no face used, dropped.
+        Vertices that no face used, dropped (trimesh's OBJ reader drops these
+        itself, so they are not counted for OBJ).
     """
 
     vertices: np.ndarray

@@ -1,0 +1,82 @@
+"""Reading mesh files: real files written by trimesh, and broken ones."""
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial import cKDTree
+
+from patterns import surfaces
+from patterns.errors import InputError
+from patterns.load import read_mesh
+
+from .conftest import SAMPLES
+
+
+def test_obj_keeps_the_file_connectivity(tmp_path):
+    v, f = surfaces.paraboloid_dish(n_faces=500)
+    path = tmp_path / "dish.obj"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    mesh = read_mesh(path)
+    assert mesh.faces.shape == f.shape and mesh.n_welded == 0 and mesh.n_unused == 0
+    np.testing.assert_array_equal(mesh.faces, f)
+    np.testing.assert_allclose(mesh.vertices, v, atol=1e-7)
+
+
+def test_stl_is_welded_explicitly(tmp_path):
+    v, f = surfaces.paraboloid_dish(n_faces=500)
+    path = tmp_path / "dish.stl"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    mesh = read_mesh(path)
+    assert len(mesh.vertices) == len(v)
+    assert mesh.n_welded == 3 * len(f) - len(v)
+    # Same surface and connectivity: map each welded vertex to its original
+    # (STL stores float32) and compare the faces, up to cyclic order.
+    dist, idx = cKDTree(v).query(mesh.vertices)
+    assert dist.max() < 1e-3 and len(np.unique(idx)) == len(v)
+
+    def canonical(faces):
+        k = np.argmin(faces, axis=1)[:, None]
+        return {tuple(row) for row in np.take_along_axis(faces, (k + np.arange(3)) % 3, axis=1)}
+
+    assert canonical(idx[mesh.faces]) == canonical(f)
+
+
+def test_unused_vertices_are_dropped(tmp_path):
+    path = tmp_path / "extra.off"
+    path.write_text("OFF\n4 1 0\n0 0 0\n9 9 9\n1 0 0\n0 1 0\n3 0 2 3\n")
+    mesh = read_mesh(path)
+    assert mesh.n_unused == 1
+    np.testing.assert_array_equal(mesh.faces, [[0, 1, 2]])
+    np.testing.assert_array_equal(mesh.vertices, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "words"),
+    [
+        ("empty.obj", b"", "holds no triangles"),
+        ("words.obj", b"this is not a mesh\n", "holds no triangles"),
+        ("empty.stl", b"", "holds no triangles"),
+        ("random.ply", bytes(range(256)) * 8, "cannot read this .ply file"),
+        ("part.step", b"ISO-10303-21;", "unknown mesh file type '.step'"),
+        ("bad-index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", None),
+    ],
+)
+def test_broken_files_give_one_error_naming_the_file(tmp_path, name, content, words):
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(InputError) as info:
+        read_mesh(path)
+    assert str(path) in str(info.value)
+    if words:
+        assert words in str(info.value)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(InputError, match="no such file"):
+        read_mesh(tmp_path / "nope.obj")
+
+
+@pytest.mark.parametrize("name", ["dish.obj", "cone.obj"])
+def test_bundled_samples_read(name):
+    mesh = read_mesh(SAMPLES / name)
+    assert len(mesh.faces) > 500
