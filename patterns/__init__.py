@@ -20,24 +20,26 @@ from .errors import (
 from .flatten import METHODS, Flattening, flatten_mesh
 from .measure import Distortion, distortion
 from .mesh import Connectivity, validate_mesh
+from .tessellate import tessellate_face
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "flatten_mesh",
-    "Flattening",
     "METHODS",
-    "distortion",
-    "Distortion",
-    "overlap_verdict",
-    "Overlap",
-    "validate_mesh",
+    "CadError",
     "Connectivity",
-    "PatternsError",
+    "Distortion",
+    "ExportError",
+    "FlattenError",
+    "Flattening",
     "InputError",
     "MeshTopologyError",
-    "CadError",
-    "FlattenError",
-    "ExportError",
+    "Overlap",
+    "PatternsError",
     "__version__",
+    "distortion",
+    "flatten_mesh",
+    "overlap_verdict",
+    "tessellate_face",
+    "validate_mesh",
 ]

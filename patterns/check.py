@@ -48,7 +48,7 @@ class Overlap:
 
     @property
     def n_folded(self) -> int:
-        return int(len(self.folded))
+        return len(self.folded)
 
 
 def overlap_verdict(faces: np.ndarray, uv: np.ndarray, loops) -> Overlap:

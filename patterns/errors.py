@@ -12,12 +12,12 @@ reported on the result.
 from __future__ import annotations
 
 __all__ = [
-    "PatternsError",
+    "CadError",
+    "ExportError",
+    "FlattenError",
     "InputError",
     "MeshTopologyError",
-    "CadError",
-    "FlattenError",
-    "ExportError",
+    "PatternsError",
 ]
 
 

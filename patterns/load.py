@@ -19,7 +19,7 @@ import numpy as np
 from .errors import InputError
 from .mesh import as_mesh_arrays
 
-__all__ = ["MESH_SUFFIXES", "MeshFile", "read_mesh", "weld", "drop_unused"]
+__all__ = ["MESH_SUFFIXES", "MeshFile", "drop_unused", "read_mesh", "weld"]
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".off")
 """File suffixes :func:`read_mesh` reads."""
@@ -128,7 +128,7 @@ def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
 
     try:
         loaded = trimesh.load(path, file_type=suffix[1:], process=False, force="mesh")
-    except Exception as exc:  # trimesh raises many kinds on a broken file
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds on a broken file
         raise InputError(f"{path}: cannot read this {suffix} file ({exc})") from None
     if isinstance(loaded, trimesh.Scene):  # pragma: no cover - force="mesh" folds scenes
         geometries = list(loaded.geometry.values())

@@ -20,15 +20,15 @@ import numpy as np
 
 __all__ = [
     "Distortion",
-    "local_coordinates",
     "affine_coefficients",
-    "principal_stretches",
-    "signed_areas",
-    "folded_faces",
-    "edge_strain",
     "area_ratio",
     "boundary_lengths",
     "distortion",
+    "edge_strain",
+    "folded_faces",
+    "local_coordinates",
+    "principal_stretches",
+    "signed_areas",
 ]
 
 

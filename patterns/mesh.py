@@ -23,10 +23,10 @@ from .errors import InputError, MeshTopologyError
 
 __all__ = [
     "Connectivity",
-    "validate_mesh",
     "as_mesh_arrays",
     "boundary_loops",
     "face_areas",
+    "validate_mesh",
 ]
 
 

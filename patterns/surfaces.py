@@ -17,14 +17,14 @@ import numpy as np
 from .errors import InputError
 
 __all__ = [
-    "disk_mesh",
-    "paraboloid_dish",
-    "spherical_cap",
-    "saddle",
-    "ellipsoid_cup",
-    "cylinder_patch",
     "cone_patch",
+    "cylinder_patch",
+    "disk_mesh",
+    "ellipsoid_cup",
     "grid_mesh",
+    "paraboloid_dish",
+    "saddle",
+    "spherical_cap",
 ]
 
 
@@ -43,7 +43,7 @@ def disk_mesh(n_faces: int) -> tuple[np.ndarray, np.ndarray]:
     """
     if n_faces < 6:
         raise InputError(f"n_faces must be at least 6, got {n_faces}")
-    k_rings = max(1, int(round(np.sqrt(n_faces / 6.0))))
+    k_rings = max(1, round(np.sqrt(n_faces / 6.0)))
     counts = 6 * np.arange(1, k_rings + 1)
     offsets = np.concatenate([[1], 1 + np.cumsum(counts)])
     ring = np.repeat(np.arange(1, k_rings + 1), counts)

@@ -17,7 +17,6 @@ from patterns.mesh import validate_mesh
 from .conftest import corpus_files
 from .helpers import random_rotation, rigid_fit_residual
 
-
 # --------------------------------------------------------------------------- contract
 
 

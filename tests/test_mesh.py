@@ -13,7 +13,7 @@ SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
 
 
 def test_square_is_valid_and_its_loop_runs_counter_clockwise():
-    v, f, conn = validate_mesh(SQUARE_V, SQUARE_F)
+    _, _, conn = validate_mesh(SQUARE_V, SQUARE_F)
     assert len(conn.edges) == 5
     assert len(conn.loops) == 1
     assert conn.loops[0].tolist() in ([0, 1, 2, 3], [1, 2, 3, 0], [2, 3, 0, 1], [3, 0, 1, 2])
@@ -119,4 +119,4 @@ def test_holes_give_one_loop_each_with_the_outer_loop_first():
     remap[used] = np.arange(len(used))
     _, _, conn = validate_mesh(v3[used], remap[f])
     assert len(conn.loops) == 3
-    assert len(conn.loops[0]) == 6 * int(round(np.sqrt(3000 / 6)))  # the rim ring
+    assert len(conn.loops[0]) == 6 * round(np.sqrt(3000 / 6))  # the rim ring

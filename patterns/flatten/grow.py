@@ -54,21 +54,20 @@ import heapq
 from collections.abc import Callable
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse import csgraph
+from scipy.sparse import coo_matrix, csgraph
 
 from ..errors import FlattenError
 from ..mesh import Connectivity
 
 __all__ = [
-    "similarity_step",
+    "grow_fronts",
+    "grow_heap",
     "rigid_step",
-    "transported_step",
-    "transported_rotations",
     "seed_face",
     "seed_layout",
-    "grow_heap",
-    "grow_fronts",
+    "similarity_step",
+    "transported_rotations",
+    "transported_step",
 ]
 
 Step = Callable[..., complex]
