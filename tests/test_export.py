@@ -68,6 +68,19 @@ def test_failed_write_leaves_nothing_and_keeps_the_old_file(tmp_path):
     assert os.listdir(tmp_path) == ["out.dxf"]
 
 
+def test_written_files_get_the_usual_permissions(tmp_path):
+    old = os.umask(0o022)
+    try:
+        write_outline_dxf(tmp_path / "new.dxf", [np.eye(3)[:, :2]])
+    finally:
+        os.umask(old)
+    assert (tmp_path / "new.dxf").stat().st_mode & 0o777 == 0o644
+    (tmp_path / "kept.dxf").write_text("old")
+    (tmp_path / "kept.dxf").chmod(0o664)
+    write_outline_dxf(tmp_path / "kept.dxf", [np.eye(3)[:, :2]])
+    assert (tmp_path / "kept.dxf").stat().st_mode & 0o777 == 0o664
+
+
 def test_bad_loop_writes_nothing(tmp_path):
     path = tmp_path / "bad.dxf"
     with pytest.raises(InputError, match="loop 1"):

@@ -12,6 +12,12 @@ from ..errors import ExportError
 __all__ = ["atomic_output"]
 
 
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
 def atomic_output(path, *, what: str = "file"):
     """Yield a temporary path to write; on success it replaces ``path``.
@@ -35,6 +41,8 @@ def atomic_output(path, *, what: str = "file"):
     os.close(fd)
     try:
         yield Path(tmp)
+        # mkstemp makes a private file: give it the mode a plain open() would.
+        os.chmod(tmp, target.stat().st_mode & 0o7777 if target.exists() else 0o666 & ~_umask())
         os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):
