@@ -2,9 +2,9 @@
 
 Run from the repository root::
 
-    /work/venv/bin/python benchmarks/bench_flatten.py                 # everything
-    /work/venv/bin/python benchmarks/bench_flatten.py --sizes 1k,10k --no-corpus
-    /work/venv/bin/python benchmarks/bench_flatten.py --markdown > tables.md
+    python benchmarks/bench_flatten.py                 # everything
+    python benchmarks/bench_flatten.py --sizes 1k,10k --no-corpus
+    python benchmarks/bench_flatten.py --markdown > tables.md
 
 Meshes
 ------
@@ -42,9 +42,13 @@ outside the timed region.  Times are the best of 3 runs up to
 from __future__ import annotations
 
 import argparse
+import os
+import platform
+import subprocess
 import sys
 import time
 from dataclasses import dataclass
+from importlib import metadata
 from pathlib import Path
 
 import numpy as np
@@ -548,6 +552,38 @@ def bench_mesh(name: str, vertices, faces, methods, args, on_row) -> list[Row]:
     return out
 
 
+def _load() -> str:
+    try:
+        return " ".join(f"{x:.2f}" for x in os.getloadavg())
+    except OSError:
+        return "n/a"
+
+
+def machine_summary() -> str:
+    """One line on the machine: cores, Python and library versions, current load."""
+    versions = []
+    for dist in ("numpy", "scipy", "libigl", "trimesh", "shapely"):
+        try:
+            versions.append(f"{dist} {metadata.version(dist)}")
+        except metadata.PackageNotFoundError:
+            versions.append(f"{dist} ?")
+    return (f"machine: {os.cpu_count()} cores ({platform.machine()}), Python {platform.python_version()}, "
+            f"patterns {patterns.__version__} ({_git_state()}), {', '.join(versions)}; "
+            f"load average at the start: {_load()}")
+
+
+def _git_state() -> str:
+    """The repository's commit, and whether ``patterns/`` differs from it."""
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True,
+                              text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", "patterns"], cwd=REPO,
+                               capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "commit unknown"
+    return f"commit {head}" + (", patterns/ modified" if dirty else "")
+
+
 def warm_up(methods) -> None:
     """Run every selected method once on a small disk, untimed (imports, first-call set-up)."""
     vertices, faces = surfaces.spherical_cap(radius=100.0, half_angle=30.0, n_faces=600)
@@ -595,6 +631,7 @@ def main(argv=None) -> int:
     sizes = parse_sizes(args.sizes)
 
     print(HEADER.format(limit=REPEAT_LIMIT, slim=SLIM_ITERATIONS))
+    print(machine_summary())
     print()
 
     def on_row(row, lscm):
@@ -607,7 +644,7 @@ def main(argv=None) -> int:
     elif not CORPUS.is_dir():
         print(f"corpus: skipped ({CORPUS} does not exist)")
     else:
-        sections.append((f"Corpus ({CORPUS.name}/)", corpus_meshes(CORPUS)))
+        sections.append(("Corpus (../shared/corpus/)", corpus_meshes(CORPUS)))
     if sizes:
         sections.append(("Generated surfaces", generated_meshes(sizes)))
 
@@ -626,6 +663,7 @@ def main(argv=None) -> int:
         for title, groups in tables:
             print(f"\n### {title}\n")
             print(markdown_table(groups))
+    print(f"\nload average at the end: {_load()}")
     return 0
 
 
