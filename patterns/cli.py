@@ -34,8 +34,9 @@ def _parser() -> argparse.ArgumentParser:
     flat.add_argument("input", type=Path, help="mesh file; coordinates taken in --units")
     flat.add_argument("-o", "--output", type=Path, required=True,
                       help="output: .dxf (cut contours on layer CUT) or .obj (flat mesh, z = 0)")
-    flat.add_argument("--method", choices=METHODS, default="isometric", help="flattening method (default isometric)")
+    flat.add_argument("--method", choices=METHODS, default="relaxed", help="flattening method (default relaxed)")
     flat.add_argument("--seed-face", type=int, default=None, help="face laid down first (default: farthest from the boundary)")
+    flat.add_argument("--max-iterations", type=int, default=50, help="relaxation iterations at most (default 50)")
     flat.add_argument("--units", choices=tuple(UNITS), default="mm", help="unit of the input coordinates (default mm)")
     return parser
 
@@ -51,7 +52,7 @@ def _flatten(args) -> int:
     mesh = read_mesh(args.input)
     start = time.perf_counter()
     result = flatten_mesh(mesh.vertices, mesh.faces, method=args.method, seed_face=args.seed_face,
-                          name=str(args.input))
+                          max_iterations=args.max_iterations, name=str(args.input))
     seconds = time.perf_counter() - start
     if suffix == ".dxf":
         write_outline_dxf(args.output, [result.uv[loop] for loop in result.loops], units=args.units)
@@ -61,7 +62,8 @@ def _flatten(args) -> int:
     u = args.units
     welded = f", {mesh.n_welded} duplicate vertices welded" if mesh.n_welded else ""
     print(f"{args.input}: {len(result.faces)} faces, {len(result.loops)} boundary loop(s){welded}")
-    print(f"flattened ({args.method}) in {seconds:.2f} s; wrote {args.output}")
+    how = f"{args.method}, from the {result.start} layout, {result.iterations} iterations" if result.start else args.method
+    print(f"flattened ({how}) in {seconds:.2f} s; wrote {args.output}")
     print(f"edge strain: RMS {100 * d.edge_strain_rms:.3f} %, max {100 * d.edge_strain_max:.3f} %")
     print(f"area: 3D {d.area_3d:.6g} {u}2, flat {d.area_flat:.6g} {u}2 ({100 * (d.area_ratio - 1):+.3f} %)")
     print(f"boundary: 3D {d.boundary_3d:.6g} {u}, flat {d.boundary_flat:.6g} {u}")

@@ -202,3 +202,30 @@ def cone_patch(*, r_bottom: float = 250.0, r_top: float = 100.0, height: float =
     r = r_bottom + (r_top - r_bottom) * st[:, 1]
     v = np.column_stack([r * np.cos(phi), r * np.sin(phi), st[:, 1] * height])
     return v, f
+
+
+def torus_patch(*, major: float = 200.0, minor: float = 80.0, around: float = 90.0, tube: float = 240.0,
+                n_faces: int = 10_000) -> tuple[np.ndarray, np.ndarray]:
+    """A patch of a torus spanning its outer (K > 0) and inner (K < 0) sides.
+
+    Parameters
+    ----------
+    major, minor : float
+        Radius of the centre circle and of the tube, mm.
+    around : float
+        Angle swept around the torus axis, degrees.
+    tube : float
+        Angle swept around the tube, degrees, centred on the outside.
+    n_faces : int
+        Approximate number of triangles.
+    """
+    length_u = np.radians(around) * (major + minor)
+    length_v = np.radians(tube) * minor
+    n_u = max(1, round(np.sqrt(n_faces / 2 * length_u / length_v)))
+    n_v = max(1, round(n_faces / (2 * n_u)))
+    st, f = grid_mesh(n_u, n_v)
+    phi = (st[:, 0] - 0.5) * np.radians(around)
+    theta = (st[:, 1] - 0.5) * np.radians(tube)
+    ring = major + minor * np.cos(theta)
+    v = np.column_stack([ring * np.cos(phi), ring * np.sin(phi), minor * np.sin(theta)])
+    return v, f

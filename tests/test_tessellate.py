@@ -29,10 +29,13 @@ def test_freeform_face_flattens_like_the_mesh_dish():
     points = [[bd.Vector(x, y, 54.0 * ((x / 300) ** 2 + (y / 300) ** 2)) for y in grid] for x in grid]
     face = bd.Face.make_surface_from_array_of_points(points)
     v, f = tessellate_face(face, tolerance=0.01)
-    r = patterns.flatten_mesh(v, f)
-    assert r.one_to_one
-    assert 0.005 < r.distortion.edge_strain_rms < 0.015  # measured 0.0097
-    assert r.distortion.area_3d == pytest.approx(face.area, rel=1e-3)
+    grown = patterns.flatten_mesh(v, f, method="isometric")
+    assert grown.one_to_one
+    assert 0.005 < grown.distortion.edge_strain_rms < 0.015  # measured 0.0097
+    assert grown.distortion.area_3d == pytest.approx(face.area, rel=1e-3)
+    relaxed = patterns.flatten_mesh(v, f)
+    assert relaxed.one_to_one
+    assert relaxed.distortion.edge_strain_rms < 0.5 * grown.distortion.edge_strain_rms  # measured 0.0030
 
 
 def test_not_a_face():

@@ -17,10 +17,12 @@ from ..errors import FlattenError, InputError
 from ..measure import Distortion, distortion, local_coordinates, signed_areas
 from ..mesh import validate_mesh
 from . import grow
+from .embed import lscm, tutte_embedding
+from .relax import align_to_pins, best_scale, check_pins, relax
 
 __all__ = ["METHODS", "Flattening", "flatten_mesh"]
 
-METHODS = ("isometric", "conformal")
+METHODS = ("relaxed", "isometric", "conformal")
 """The flattening methods :func:`flatten_mesh` accepts."""
 
 
@@ -46,9 +48,18 @@ class Flattening:
         Boundary loops (vertex indices, surface to their left; longest first).
     method : str
     seed_face : int
-        The triangle laid down first, without distortion.
+        The triangle the greedy grower laid down first, without distortion.
     overlap : Overlap
         The overlap verdict: folded triangles, loop tests, ``one_to_one``.
+    start : str
+        ``"relaxed"`` only: the layout the relaxation started from --
+        ``"greedy"`` (the isometric grower's, when it is one-to-one), else
+        ``"lscm"`` (when that is one-to-one), else ``"tutte"``; "" otherwise.
+    iterations : int
+        ``"relaxed"`` only: relaxation iterations run (0 otherwise).
+    converged : bool
+        ``"relaxed"``: the stress stopped decreasing (by the tolerance) and the
+        pins were reached within ``max_iterations``.  True for the growers.
     """
 
     uv: np.ndarray
@@ -58,6 +69,9 @@ class Flattening:
     method: str
     seed_face: int
     overlap: Overlap
+    start: str = ""
+    iterations: int = 0
+    converged: bool = True
 
     @property
     def one_to_one(self) -> bool:
@@ -75,7 +89,8 @@ class Flattening:
         return distortion(self.vertices, self.faces, self.uv, loops=self.loops)
 
 
-def flatten_mesh(vertices, faces, *, method: str = "isometric", seed_face: int | None = None,
+def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | None = None,
+                 pins=None, max_iterations: int = 50, tolerance: float = 1e-4,
                  progress=None, name: str = "mesh") -> Flattening:
     """Flatten a triangle mesh to the plane at true scale.
 
@@ -87,13 +102,19 @@ def flatten_mesh(vertices, faces, *, method: str = "isometric", seed_face: int |
     faces : array_like, (m, 3) int
         Consistently wound triangles forming one connected planar domain (a disk,
         or a disk with holes).
-    method : {"isometric", "conformal"}
-        ``"isometric"`` (default): the greedy grower with length-preserving
+    method : {"relaxed", "isometric", "conformal"}
+        ``"relaxed"`` (default): the ``"isometric"`` layout -- or, where that
+        overlaps itself, a conformal (LSCM) or Tutte layout -- relaxed towards
+        true edge lengths (least squared edge strain) while every triangle keeps
+        its orientation and the boundary never crosses itself: the result is
+        always one-to-one.  Use it for patterns.
+
+        ``"isometric"``: the greedy grower with length-preserving
         steps, each triangle placed at its true size and rotated by a frame
         carried across the mesh, one vectorised pass per front.  Exact on
         developable meshes, stable under refinement, fast (a million faces in
         about two seconds); it can fold on strongly curved parts, which the
-        overlap verdict reports.  Use it for patterns.
+        overlap verdict reports.
 
         ``"conformal"``: the paper as written (Li & Xue): one vertex at a time,
         shortest front first, each candidate from the Cauchy-Riemann equations of
@@ -102,9 +123,20 @@ def flatten_mesh(vertices, faces, *, method: str = "isometric", seed_face: int |
         errors of 1e3 at 10k faces, overflow near a million.  Kept as the
         faithful reference for measurements, not for cutting.
     seed_face : int, optional
-        The triangle laid down first; default the one farthest from the boundary.
+        The triangle the grower lays down first; default the one farthest from
+        the boundary.
+    pins : tuple of ((k,) int, (k, 2) float), optional
+        ``"relaxed"`` only: vertices held at given flat positions (libigl's
+        ``b, bc``), in the mesh unit.  The start is first moved rigidly onto
+        them; they are then reached step by step unless that would fold.
+    max_iterations : int
+        ``"relaxed"`` only: at most this many relaxation iterations (> 0).
+    tolerance : float
+        ``"relaxed"`` only: stop when an iteration lowers the summed squared
+        edge strain by less than this fraction (>= 0).
     progress : callable, optional
-        Called as ``progress(n_done, n_total)`` (vertices placed) as the grower runs.
+        Called as ``progress(n_done, n_total)``: vertices placed by a grower,
+        then iterations of the relaxation.
     name : str
         How the mesh is named in error messages.
 
@@ -131,6 +163,14 @@ def flatten_mesh(vertices, faces, *, method: str = "isometric", seed_face: int |
         if isinstance(seed_face, bool) or not isinstance(seed_face, (int, np.integer)) or not 0 <= seed_face < len(f):
             raise InputError(f"{name}: seed_face must be a face index in [0, {len(f)}), got {seed_face!r}")
         seed = int(seed_face)
+    if method != "relaxed" and pins is not None:
+        raise InputError(f"{name}: pins apply to method='relaxed' only")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
+        raise InputError(f"{name}: max_iterations must be a positive integer, got {max_iterations!r}")
+    if not (isinstance(tolerance, (int, float, np.floating)) and tolerance >= 0):
+        raise InputError(f"{name}: tolerance must be a number >= 0, got {tolerance!r}")
+    if pins is not None:
+        pins = check_pins(pins, len(v), name)
     z = local_coordinates(v, f)
     weights = 0.5 * np.abs((np.conj(z[:, 1]) * z[:, 2]).imag)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -139,8 +179,10 @@ def flatten_mesh(vertices, faces, *, method: str = "isometric", seed_face: int |
         else:
             rotations = grow.transported_rotations(z, f, conn, seed)
             w = grow.grow_fronts(z, f, conn, weights, seed, grow.transported_step,
-                                 rotations=rotations, progress=progress)
+                                 rotations=rotations, progress=None if method == "relaxed" else progress)
     uv = np.column_stack([w.real, w.imag])
+    if method == "relaxed":
+        return _relaxed(v, f, conn, uv, seed, z, pins, max_iterations, tolerance, progress)
     # Beyond ~1e154 the flat triangles' areas overflow double precision: such a
     # result cannot even be checked, so it is an error, not an answer.
     with np.errstate(over="ignore", invalid="ignore"):
@@ -158,4 +200,34 @@ def flatten_mesh(vertices, faces, *, method: str = "isometric", seed_face: int |
         method=method,
         seed_face=seed,
         overlap=overlap_verdict(f, uv, conn.loops),
+    )
+
+
+def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progress) -> Flattening:
+    """Pick a one-to-one start (greedy, else LSCM, else Tutte) and relax it."""
+    start, label = greedy, "greedy"
+    if not overlap_verdict(f, start, conn.loops).one_to_one:
+        start, label = lscm(v, f, conn, local=z), "lscm"
+        if not overlap_verdict(f, start, conn.loops).one_to_one:
+            start, label = tutte_embedding(v, f, conn), "tutte"
+        # These layouts have no true scale of their own: start from the best one.
+        start = start * best_scale(v, conn.edges, start)
+    if pins is not None:
+        start = align_to_pins(start, *pins)
+        if not overlap_verdict(f, start, conn.loops).one_to_one:  # pragma: no cover - rigid motions keep it
+            start = tutte_embedding(v, f, conn)
+    result = relax(v, f, conn, start, pins=pins, max_iterations=max_iterations, tolerance=tolerance,
+                   progress=progress)
+    uv = np.array(result.uv)
+    return Flattening(
+        uv=_readonly(uv),
+        vertices=_readonly(v),
+        faces=_readonly(f),
+        loops=conn.loops,
+        method="relaxed",
+        seed_face=seed,
+        overlap=overlap_verdict(f, uv, conn.loops),
+        start=label,
+        iterations=result.iterations,
+        converged=result.converged,
     )

@@ -1,0 +1,156 @@
+"""The relaxed method: always one-to-one, closer to true lengths, pins, options."""
+
+import numpy as np
+import pytest
+import shapely
+
+import patterns
+from patterns import surfaces
+from patterns.errors import InputError
+from patterns.flatten.embed import lscm, tutte_embedding
+from patterns.flatten.relax import flip_free_steps
+from patterns.mesh import validate_mesh
+
+from .helpers import rigid_fit_residual
+
+SHAPES = {
+    "hemisphere": lambda n: surfaces.spherical_cap(radius=100.0, half_angle=90.0, n_faces=n),
+    "cap60": lambda n: surfaces.spherical_cap(radius=100.0, half_angle=30.0, n_faces=n),
+    "cup": lambda n: surfaces.ellipsoid_cup(n_faces=n),
+    "saddle": lambda n: surfaces.saddle(n_faces=n),
+    "torus": lambda n: surfaces.torus_patch(n_faces=n),
+    "dish": lambda n: surfaces.paraboloid_dish(n_faces=n),
+}
+
+
+def _independent_one_to_one(faces, uv):
+    tris = shapely.polygons(uv[faces])
+    areas = shapely.area(tris)
+    return bool(np.all(shapely.is_ccw(shapely.get_exterior_ring(tris))) and np.all(areas > 0)
+                and shapely.union_all(tris).area >= (1 - 1e-9) * areas.sum())
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_generated_parts_come_out_one_to_one_and_closer_to_true_lengths(shape):
+    v, f = SHAPES[shape](10_000)
+    greedy = patterns.flatten_mesh(v, f, method="isometric")
+    r = patterns.flatten_mesh(v, f)
+    assert r.method == "relaxed" and r.n_folded == 0 and r.one_to_one
+    assert _independent_one_to_one(r.faces, r.uv)
+    assert r.distortion.edge_strain_rms <= greedy.distortion.edge_strain_rms
+    if greedy.one_to_one:
+        assert r.start == "greedy"
+        # Measured: 0.58-0.62 of the greedy RMS on these parts.
+        assert r.distortion.edge_strain_rms < 0.8 * greedy.distortion.edge_strain_rms
+    # True scale: no rescaling, the flat area stays within the part's own strain.
+    assert abs(r.distortion.area_ratio - 1) < 3 * r.distortion.edge_strain_rms + 1e-3
+
+
+def test_flip_free_steps_are_exact():
+    rng = np.random.default_rng(5)
+    p, f = surfaces.disk_mesh(300)
+    step = rng.normal(scale=0.2, size=p.shape)
+    t = flip_free_steps(f, p, step)
+    finite = np.isfinite(t)
+    assert finite.any()
+    area = patterns.measure.signed_areas
+    k = np.flatnonzero(finite)[:50]
+    assert np.all(area(f[k], p) > 0)
+    for i in k:
+        tri = f[i:i + 1]
+        assert area(tri, p + 0.999 * t[i] * step)[0] > 0
+        assert area(tri, p + 1.001 * t[i] * step)[0] < 0
+
+
+def test_tutte_embedding_is_one_to_one_with_holes_and_true_perimeter():
+    p, f = surfaces.disk_mesh(4000)
+    c = p[f].mean(axis=1)
+    f = f[(np.linalg.norm(c - [0.4, 0], axis=1) > 0.2) & (np.linalg.norm(c + [0.4, 0], axis=1) > 0.15)]
+    used = np.unique(f)
+    remap = np.full(len(p), -1)
+    remap[used] = np.arange(len(used))
+    p, f = p[used] * 200.0, remap[f]
+    v = np.column_stack([p, 80.0 * np.sin(p[:, 0] / 100.0)])
+    v, f, conn = validate_mesh(v, f)
+    uv = tutte_embedding(v, f, conn)
+    assert patterns.overlap_verdict(f, uv, conn.loops).one_to_one
+    outer = conn.loops[0]
+    radius = np.linalg.norm(uv[outer], axis=1)
+    length3d = np.linalg.norm(v[np.roll(outer, -1)] - v[outer], axis=1).sum()
+    np.testing.assert_allclose(radius, length3d / (2 * np.pi), rtol=1e-12)
+
+
+def test_lscm_reproduces_a_flat_part_exactly():
+    p, f = surfaces.disk_mesh(2000)
+    v = np.column_stack([p * 150.0, np.zeros(len(p))])
+    v, f, conn = validate_mesh(v, f)
+    uv = lscm(v, f, conn)
+    assert rigid_fit_residual(uv, v[:, :2]) < 1e-8
+
+
+def test_compatible_pins_are_reached_exactly():
+    v, f = surfaces.paraboloid_dish(n_faces=3000)
+    free = patterns.flatten_mesh(v, f)
+    idx = np.array([0, 5, 400])
+    theta = 0.3
+    rot = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    target = free.uv[idx] @ rot.T + [1000.0, -50.0]  # a rigid motion of a free solution
+    r = patterns.flatten_mesh(v, f, pins=(idx, target))
+    np.testing.assert_allclose(r.uv[idx], target, atol=1e-9)
+    assert r.converged and r.one_to_one
+    assert r.distortion.edge_strain_rms == pytest.approx(free.distortion.edge_strain_rms, rel=0.05)
+
+
+def test_pins_that_would_fold_the_pattern_stop_short_and_never_fold():
+    v, f = surfaces.paraboloid_dish(n_faces=2000)
+    _, _, conn = validate_mesh(v, f)
+    rim = conn.loops[0]
+    a, b, c = rim[0], rim[len(rim) // 2], rim[len(rim) // 4]
+    free = patterns.flatten_mesh(v, f).uv
+    # Swap two opposite rim points and hold a third: a mirror image, which no
+    # rigid motion gives and no fold-free layout reaches.
+    r = patterns.flatten_mesh(v, f, pins=([a, b, c], [free[b], free[a], free[c]]))
+    assert r.n_folded == 0 and r.one_to_one
+    assert not r.converged
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"pins": ([0, 1], [[0.0, 0.0]])}, "pins must be"),
+        ({"pins": ([0, 10**6], [[0.0, 0.0], [1.0, 0.0]])}, "in [0,"),
+        ({"pins": ([3, 3], [[0.0, 0.0], [1.0, 0.0]])}, "pinned twice"),
+        ({"pins": ([3], [[np.nan, 0.0]])}, "finite"),
+        ({"pins": 7}, "pins must be"),
+        ({"pins": ([0], [[0.0, 0.0]]), "method": "isometric"}, "method='relaxed' only"),
+        ({"max_iterations": 0}, "max_iterations"),
+        ({"tolerance": -1.0}, "tolerance"),
+    ],
+)
+def test_bad_options(kwargs, words):
+    v, f = surfaces.paraboloid_dish(n_faces=300)
+    with pytest.raises(InputError, match=None) as info:
+        patterns.flatten_mesh(v, f, **kwargs)
+    assert words in str(info.value)
+
+
+def test_iterations_and_progress():
+    v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=3000)
+    calls = []
+    r = patterns.flatten_mesh(v, f, max_iterations=3, tolerance=0.0,
+                              progress=lambda done, total: calls.append((done, total)))
+    assert r.iterations == 3 and calls == [(1, 3), (2, 3), (3, 3)]
+    assert not r.converged
+    longer = patterns.flatten_mesh(v, f, max_iterations=200, tolerance=1e-6)
+    assert longer.distortion.edge_strain_rms <= r.distortion.edge_strain_rms
+
+
+def test_where_the_grower_overlaps_the_relaxation_starts_elsewhere_and_stays_one_to_one():
+    """Where the greedy layout overlaps (a torus patch 300 degrees each way),
+    the relaxation starts from LSCM or Tutte and still ends one-to-one."""
+    v, f = surfaces.torus_patch(around=300.0, tube=300.0, n_faces=4000)
+    greedy = patterns.flatten_mesh(v, f, method="isometric")
+    r = patterns.flatten_mesh(v, f)
+    assert not greedy.one_to_one
+    assert r.start in ("lscm", "tutte") and r.one_to_one and r.n_folded == 0
+    assert _independent_one_to_one(r.faces, r.uv)
