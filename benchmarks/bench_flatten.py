@@ -11,13 +11,17 @@ Meshes
 * every ``*.obj`` / ``*.off`` in ``../shared/corpus/`` relative to the repository
   root, loaded with ``trimesh.load(path, process=False)`` (skipped, with the
   reason printed, when the folder is absent or ``--no-corpus`` is given);
-* generated surfaces at about 1k, 10k, 100k and 1M faces: a 60 degree spherical
-  cap (``cap60``), a paraboloid dish, a saddle and a half cylinder.
+* generated surfaces at about 1k, 10k, 100k and 1M faces (``--sizes``): a 60
+  degree spherical cap (``cap60``), a paraboloid dish, a saddle and a half
+  cylinder; and at about 10k and 100k faces only (``--extra-sizes``): a
+  hemisphere, an ellipsoid cup and a torus patch.
 
 Methods
 -------
-* ``isometric``, ``conformal``: :func:`patterns.flatten_mesh`; the time covers the
-  whole call (input validation, the grower and the overlap verdict).
+* ``relaxed``, ``isometric``, ``conformal``: :func:`patterns.flatten_mesh` with default
+  options; the time covers the whole call (input validation, the grower, for
+  ``relaxed`` the relaxation, and the overlap verdict).  The note of a ``relaxed``
+  row gives its start layout and iteration count.
 * ``lscm``: ``igl.lscm`` with the two farthest-apart boundary vertices pinned at
   their 3D distance apart.  LSCM has no scale of its own, so before measuring its
   uv is multiplied by the single factor that makes the total flat area equal to
@@ -37,11 +41,26 @@ Every row is measured by the same code, :func:`patterns.distortion` (edge strain
 RMS and max, folded triangles) and :func:`patterns.overlap_verdict` (one-to-one),
 outside the timed region.  Times are the best of 3 runs up to
 ``REPEAT_LIMIT`` faces and of 1 run above, all methods in the same process.
+
+Acceptance summary
+------------------
+After the tables the script prints, for every mesh, ``relaxed`` against libigl
+ARAP and SLIM with a PASS/FAIL per criterion of the issue:
+
+* edge-strain RMS <= 0.95 x ARAP's where ARAP has no folded triangle; where ARAP
+  folds, RMS lower than SLIM's;
+* at about 100k faces (``ACCEPT_100K``): time <= ARAP's, and SLIM's time >= 3 x ours;
+* at about 1M faces (``ACCEPT_1M``): time (the table's row) under 30 s and peak
+  memory under 4 GB.  The memory is the peak resident set size (``ru_maxrss``) of a
+  separate child process that imports ``patterns``, generates the mesh and runs
+  ``flatten_mesh(V, F)`` once (so it includes the interpreter, the imports and the
+  input arrays).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import subprocess
@@ -70,7 +89,7 @@ CORPUS = REPO.parent / "shared" / "corpus"
 SIZES = {"1k": 1_000, "10k": 10_000, "100k": 100_000, "1M": 1_000_000}
 """Face counts of the generated surfaces, by the label used on the command line."""
 
-ALL_METHODS = ("isometric", "conformal", "lscm", "arap", "slim")
+ALL_METHODS = ("relaxed", "isometric", "conformal", "lscm", "arap", "slim")
 """Every method the benchmark knows, in the order the rows are printed."""
 
 REPEAT_LIMIT = 200_000
@@ -78,6 +97,22 @@ REPEAT_LIMIT = 200_000
 
 SLIM_ITERATIONS = 20
 """Iterations of ``igl.slim_solve``."""
+
+ACCEPT_STRAIN_RATIO = 0.95
+"""Acceptance: ``relaxed`` RMS strain at most this times ARAP's (where ARAP does not fold)."""
+
+ACCEPT_100K = (80_000, 200_000)
+"""Acceptance: meshes with a face count in this range are judged on the 100k time criteria."""
+
+ACCEPT_SLIM_SPEEDUP = 3.0
+"""Acceptance at 100k: SLIM's time at least this many times ``relaxed``'s."""
+
+ACCEPT_1M = 500_000
+"""Acceptance: meshes with at least this many faces are judged on the 1M time and memory criteria."""
+
+ACCEPT_1M_SECONDS = 30.0
+ACCEPT_1M_BYTES = 4 * 1024 ** 3
+"""Acceptance at 1M: time under 30 s, peak resident memory under 4 GiB."""
 
 
 # --------------------------------------------------------------------------- #

@@ -87,3 +87,12 @@ def test_debug_shows_the_traceback(tmp_path):
 def test_usage_error_exits_2():
     proc = run("flatten")
     assert proc.returncode == 2 and "usage:" in proc.stderr
+
+
+def test_relaxed_is_the_default_and_reports_its_start(tmp_path):
+    proc = run("flatten", SAMPLES / "dish.obj", "-o", tmp_path / "a.dxf", "--max-iterations", "3")
+    assert proc.returncode == 0, proc.stderr
+    assert "(relaxed, from the greedy layout, 3 iterations)" in proc.stdout
+    bad = run("flatten", SAMPLES / "dish.obj", "-o", tmp_path / "b.dxf", "--max-iterations", "0")
+    assert bad.returncode == 2 and "max_iterations" in bad.stderr
+    assert not (tmp_path / "b.dxf").exists()

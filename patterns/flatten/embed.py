@@ -20,7 +20,7 @@ import scipy.sparse.linalg as spla
 
 from ..mesh import Connectivity
 
-__all__ = ["tutte_embedding", "lscm", "factorize"]
+__all__ = ["factorize", "lscm", "tutte_embedding"]
 
 
 def factorize(matrix: sp.spmatrix):

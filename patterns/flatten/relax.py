@@ -31,7 +31,7 @@ from ..measure import signed_areas
 from ..mesh import Connectivity
 from .embed import factorize
 
-__all__ = ["Relaxation", "relax", "flip_free_steps", "align_to_pins", "best_scale"]
+__all__ = ["Relaxation", "align_to_pins", "best_scale", "flip_free_steps", "relax"]
 
 
 @dataclass(frozen=True, eq=False)
