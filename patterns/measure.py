@@ -106,10 +106,10 @@ def principal_stretches(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray)
 
 def signed_areas(faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
     """Signed flat areas ``(m,) float64`` (positive = counter-clockwise)."""
-    p = uv[faces]
-    a = p[:, 1] - p[:, 0]
-    b = p[:, 2] - p[:, 0]
-    return 0.5 * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    x, y = uv[:, 0], uv[:, 1]
+    i, j, k = faces[:, 0], faces[:, 1], faces[:, 2]
+    x0, y0 = x[i], y[i]
+    return 0.5 * ((x[j] - x0) * (y[k] - y0) - (y[j] - y0) * (x[k] - x0))
 
 
 def folded_faces(faces: np.ndarray, uv: np.ndarray) -> np.ndarray:

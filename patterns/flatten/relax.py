@@ -52,7 +52,7 @@ class Relaxation:
     converged: bool
 
 
-def flip_free_steps(faces: np.ndarray, uv: np.ndarray, step: np.ndarray) -> np.ndarray:
+def flip_free_steps(faces: np.ndarray, uv: np.ndarray, step: np.ndarray, *, horizon: float = np.inf) -> np.ndarray:
     """Largest ``t`` per triangle such that ``uv + s * step`` keeps it positive for all ``s < t``.
 
     The signed area along the step is the quadratic ``a2 t**2 + a1 t + a0``
@@ -62,31 +62,45 @@ def flip_free_steps(faces: np.ndarray, uv: np.ndarray, step: np.ndarray) -> np.n
     ----------
     faces : (m, 3) int64
     uv, step : (n, 2) float64
+    horizon : float
+        Only roots below this matter: triangles whose area stays positive up to
+        ``horizon`` get ``inf`` without solving (much faster when most are safe).
 
     Returns
     -------
     (m,) float64
     """
-    p, q = uv[faces], step[faces]
-    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    d1, d2 = q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]
-
-    def cross(a, b):
-        return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-
-    a0 = cross(e1, e2)
-    a1 = cross(e1, d2) + cross(d1, e2)
-    a2 = cross(d1, d2)
+    # Column gathers: several times faster than gathering (m, 3, 2) blocks.
+    i, j, k = faces[:, 0], faces[:, 1], faces[:, 2]
+    x, y, dx, dy = uv[:, 0], uv[:, 1], step[:, 0], step[:, 1]
+    x0, y0, dx0, dy0 = x[i], y[i], dx[i], dy[i]
+    e1x, e1y, e2x, e2y = x[j] - x0, y[j] - y0, x[k] - x0, y[k] - y0
+    d1x, d1y, d2x, d2y = dx[j] - dx0, dy[j] - dy0, dx[k] - dx0, dy[k] - dy0
+    a0 = e1x * e2y - e1y * e2x
+    a1 = e1x * d2y - e1y * d2x + d1x * e2y - d1y * e2x
+    a2 = d1x * d2y - d1y * d2x
     t = np.full(len(faces), np.inf)
+    if np.isfinite(horizon):
+        # Positive at both ends of [0, horizon] and not dipping in between: safe.
+        end = (a2 * horizon + a1) * horizon + a0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            vertex = -a1 / (2 * a2)
+            dips = (a2 > 0) & (vertex > 0) & (vertex < horizon) & (a0 - a1 * a1 / (4 * a2) <= 0)
+        risky = np.flatnonzero((end <= 0) | dips)
+    else:
+        risky = np.arange(len(faces))
+    a0, a1, a2 = a0[risky], a1[risky], a2[risky]
+    r_best = np.full(len(risky), np.inf)
     with np.errstate(divide="ignore", invalid="ignore"):
         linear = np.abs(a2) <= 1e-14 * np.abs(a0)
         root = -a0 / a1
-        t = np.where(linear & (root > 0), root, t)
+        r_best = np.where(linear & (root > 0), root, r_best)
         disc = a1 * a1 - 4 * a2 * a0
         sq = np.sqrt(np.maximum(disc, 0.0))
         for r in ((-a1 - sq) / (2 * a2), (-a1 + sq) / (2 * a2)):
             ok = ~linear & (disc >= 0) & (r > 0)
-            t = np.where(ok & (r < t), r, t)
+            r_best = np.where(ok & (r < r_best), r, r_best)
+    t[risky] = r_best
     return t
 
 
@@ -166,8 +180,9 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     lu = factorize(system)
 
     def majorize(u):
+        """The majorizer's minimiser from ``u``, and the stress at ``u``."""
         d = u[e[:, 1]] - u[e[:, 0]]
-        dl = np.linalg.norm(d, axis=1)
+        dl = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2)
         q = d * (weight * length / np.maximum(dl, 1e-300))[:, None]
         rhs = np.empty((n, 2))
         for k in range(2):
@@ -179,22 +194,19 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         else:
             target[~free] = pin_target
             target[free] = lu.solve(rhs[free] - coupling @ pin_target)
-        return target
-
-    def stress(u):
-        return float(np.sum((np.linalg.norm(u[e[:, 1]] - u[e[:, 0]], axis=1) / length - 1.0) ** 2))
+        return target, float(np.sum((dl / length - 1.0) ** 2))
 
     def pins_reached(u):
         return np.allclose(u[pin_index], pin_target, rtol=0, atol=1e-9 * _size(u))
 
-    energy = stress(uv)
+    target, energy = majorize(uv)
     best, best_energy = uv, energy
     converged = False
     iterations = 0
     for iterations in range(1, max_iterations + 1):
-        moved = _safe_move(faces, conn.loops, uv, majorize(uv))
+        moved = _safe_move(faces, conn.loops, uv, target)
         stuck = moved is uv
-        new_energy = stress(moved)
+        target, new_energy = majorize(moved)
         small = 0.0 <= energy - new_energy <= tolerance * energy
         uv, energy = moved, new_energy
         # Cut steps are not guaranteed to lower the stress: keep the best
@@ -224,7 +236,7 @@ def _safe_move(faces: np.ndarray, loops, uv: np.ndarray, target: np.ndarray, *, 
     step = target - uv
     n = len(uv)
     alpha = np.ones(n)
-    per_face = np.minimum(0.9 * flip_free_steps(faces, uv, step), 1.0)
+    per_face = np.minimum(0.9 * flip_free_steps(faces, uv, step, horizon=1.0 / 0.9), 1.0)
     np.minimum.at(alpha, faces.ravel(), np.repeat(per_face, 3))
     for attempt in range(2 * tries):
         cand = uv + alpha[:, None] * step
