@@ -213,9 +213,7 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
         # These layouts have no true scale of their own: start from the best one.
         start = start * best_scale(v, conn.edges, start)
     if pins is not None:
-        start = align_to_pins(start, *pins)
-        if not overlap_verdict(f, start, conn.loops).one_to_one:  # pragma: no cover - rigid motions keep it
-            start = tutte_embedding(v, f, conn)
+        start = align_to_pins(start, *pins)  # a rigid motion: still one-to-one
     result = relax(v, f, conn, start, pins=pins, max_iterations=max_iterations, tolerance=tolerance,
                    progress=progress)
     uv = np.array(result.uv)
