@@ -134,6 +134,13 @@ def test_bad_options(kwargs, words):
     assert words in str(info.value)
 
 
+def test_an_exact_start_stops_at_once():
+    v, f = surfaces.cylinder_patch(n_around=200, n_along=60)
+    r = patterns.flatten_mesh(v, f)
+    assert r.start == "greedy" and r.converged and r.iterations == 0
+    assert r.distortion.edge_strain_max < 1e-9
+
+
 def test_iterations_and_progress():
     v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=3000)
     calls = []
