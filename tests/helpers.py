@@ -1,6 +1,7 @@
 """Helpers shared by the tests (independent of the code under test)."""
 
 import numpy as np
+import shapely
 
 
 def random_rotation(rng: np.random.Generator) -> np.ndarray:
@@ -23,3 +24,13 @@ def rigid_fit_residual(a: np.ndarray, b: np.ndarray) -> float:
     d = np.sign(np.linalg.det(vt.T @ u.T))
     rot = vt.T @ np.diag([1.0, d]) @ u.T
     return float(np.abs((a - ca) @ rot.T - (b - cb)).max())
+
+
+def independent_one_to_one(faces: np.ndarray, uv: np.ndarray) -> bool:
+    """One-to-one by area, with shapely only: every triangle counter-clockwise and
+    the union of all triangles as large as the sum of their areas."""
+    tris = shapely.polygons(uv[faces])
+    areas = shapely.area(tris)
+    if not (np.all(shapely.is_ccw(shapely.get_exterior_ring(tris))) and np.all(areas > 0)):
+        return False
+    return shapely.union_all(tris).area >= (1 - 1e-9) * areas.sum()

@@ -15,7 +15,7 @@ from patterns.measure import local_coordinates
 from patterns.mesh import validate_mesh
 
 from .conftest import corpus_files
-from .helpers import random_rotation, rigid_fit_residual
+from .helpers import independent_one_to_one, random_rotation, rigid_fit_residual
 
 GROWERS = ("isometric", "conformal")
 
@@ -304,18 +304,6 @@ def test_surface_with_holes_flattens_one_to_one():
 # --------------------------------------------------------------------------- corpus
 
 
-def _independent_one_to_one(faces, uv):
-    """One-to-one by area, with shapely only: every triangle counter-clockwise and
-    the union of all triangles as large as the sum of their areas."""
-    tris = shapely.polygons(uv[faces])
-    if not np.all(shapely.is_ccw(shapely.get_exterior_ring(tris))):
-        return False
-    areas = shapely.area(tris)
-    if np.any(areas <= 0):
-        return False
-    return shapely.union_all(tris).area >= (1 - 1e-9) * areas.sum()
-
-
 @pytest.mark.parametrize("path", corpus_files())
 @pytest.mark.parametrize("method", patterns.METHODS)
 def test_corpus_verdict_is_truthful(path, method):
@@ -328,7 +316,7 @@ def test_corpus_verdict_is_truthful(path, method):
         assert method == "conformal"
         return
     assert np.all(np.isfinite(r.uv))
-    assert r.one_to_one == _independent_one_to_one(r.faces, r.uv)
+    assert r.one_to_one == independent_one_to_one(r.faces, r.uv)
     tris = shapely.polygons(r.uv[r.faces])
     folded = int(np.sum(~(shapely.area(tris) > 0) | ~shapely.is_ccw(shapely.get_exterior_ring(tris))))
     if method == "isometric":

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-import shapely
 
 import patterns
 from patterns import surfaces
@@ -11,7 +10,7 @@ from patterns.flatten.embed import lscm, tutte_embedding
 from patterns.flatten.relax import flip_free_steps
 from patterns.mesh import validate_mesh
 
-from .helpers import rigid_fit_residual
+from .helpers import independent_one_to_one, rigid_fit_residual
 
 SHAPES = {
     "hemisphere": lambda n: surfaces.spherical_cap(radius=100.0, half_angle=90.0, n_faces=n),
@@ -23,20 +22,13 @@ SHAPES = {
 }
 
 
-def _independent_one_to_one(faces, uv):
-    tris = shapely.polygons(uv[faces])
-    areas = shapely.area(tris)
-    return bool(np.all(shapely.is_ccw(shapely.get_exterior_ring(tris))) and np.all(areas > 0)
-                and shapely.union_all(tris).area >= (1 - 1e-9) * areas.sum())
-
-
 @pytest.mark.parametrize("shape", SHAPES)
 def test_generated_parts_come_out_one_to_one_and_closer_to_true_lengths(shape):
     v, f = SHAPES[shape](10_000)
     greedy = patterns.flatten_mesh(v, f, method="isometric")
     r = patterns.flatten_mesh(v, f)
     assert r.method == "relaxed" and r.n_folded == 0 and r.one_to_one
-    assert _independent_one_to_one(r.faces, r.uv)
+    assert independent_one_to_one(r.faces, r.uv)
     assert r.distortion.edge_strain_rms <= greedy.distortion.edge_strain_rms
     if greedy.one_to_one:
         assert r.start == "greedy"
@@ -160,4 +152,4 @@ def test_where_the_grower_overlaps_the_relaxation_starts_elsewhere_and_stays_one
     r = patterns.flatten_mesh(v, f)
     assert not greedy.one_to_one
     assert r.start in ("lscm", "tutte") and r.one_to_one and r.n_folded == 0
-    assert _independent_one_to_one(r.faces, r.uv)
+    assert independent_one_to_one(r.faces, r.uv)
