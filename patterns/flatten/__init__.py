@@ -156,6 +156,13 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
     """
     if method not in METHODS:
         raise InputError(f"unknown flattening method {method!r}; choose one of {', '.join(METHODS)}")
+    # Cheap option checks before the mesh is validated (a second at 1M faces).
+    if method != "relaxed" and pins is not None:
+        raise InputError(f"{name}: pins apply to method='relaxed' only")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
+        raise InputError(f"{name}: max_iterations must be a positive integer, got {max_iterations!r}")
+    if not (isinstance(tolerance, (int, float, np.floating)) and tolerance >= 0):
+        raise InputError(f"{name}: tolerance must be a number >= 0, got {tolerance!r}")
     v, f, conn = validate_mesh(vertices, faces, name=name)
     if seed_face is None:
         seed = grow.seed_face(v, f, conn)
@@ -163,12 +170,6 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         if isinstance(seed_face, bool) or not isinstance(seed_face, (int, np.integer)) or not 0 <= seed_face < len(f):
             raise InputError(f"{name}: seed_face must be a face index in [0, {len(f)}), got {seed_face!r}")
         seed = int(seed_face)
-    if method != "relaxed" and pins is not None:
-        raise InputError(f"{name}: pins apply to method='relaxed' only")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
-        raise InputError(f"{name}: max_iterations must be a positive integer, got {max_iterations!r}")
-    if not (isinstance(tolerance, (int, float, np.floating)) and tolerance >= 0):
-        raise InputError(f"{name}: tolerance must be a number >= 0, got {tolerance!r}")
     if pins is not None:
         pins = check_pins(pins, len(v), name)
     z = local_coordinates(v, f)
