@@ -7,7 +7,8 @@ import patterns
 from patterns import surfaces
 from patterns.errors import InputError
 from patterns.flatten.embed import lscm, tutte_embedding
-from patterns.flatten.relax import flip_free_steps
+from patterns.load import read_mesh
+from patterns.flatten.relax import best_scale, flip_free_steps
 from patterns.mesh import validate_mesh
 
 from .helpers import independent_one_to_one, rigid_fit_residual
@@ -153,3 +154,52 @@ def test_where_the_grower_overlaps_the_relaxation_starts_elsewhere_and_stays_one
     assert not greedy.one_to_one
     assert r.start in ("lscm", "tutte") and r.one_to_one and r.n_folded == 0
     assert independent_one_to_one(r.faces, r.uv)
+
+
+def test_energy_gradient_matches_finite_differences():
+    from patterns.flatten.relax import _StressBarrier
+
+    v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=400)
+    v, f, conn = validate_mesh(v, f)
+    uv = np.array(patterns.flatten_mesh(v, f, method="isometric").uv)
+    rng = np.random.default_rng(3)
+    uv += rng.normal(scale=0.05, size=uv.shape)  # off the optimum, still fold-free
+    assert np.all(patterns.measure.signed_areas(f, uv) > 0)
+    energy = _StressBarrier(v, f, conn.edges, np.linalg.norm(v[conn.edges[:, 1]] - v[conn.edges[:, 0]], axis=1))
+    for mu in (0.0, 0.1):
+        value, grad = energy(uv, mu)
+        direction = rng.normal(size=uv.shape)
+        h = 1e-6
+        numeric = (energy(uv + h * direction, mu)[0] - energy(uv - h * direction, mu)[0]) / (2 * h)
+        assert numeric == pytest.approx(float(np.sum(grad * direction)), rel=1e-6)
+    # The barrier is |J^-1|^2 summed with weights: 2 per unit weight on a rigid
+    # layout, here a flat part laid down as it is.
+    p, f = surfaces.disk_mesh(300)
+    v, f, conn = validate_mesh(np.column_stack([p * 50.0, np.zeros(len(p))]), f)
+    flat = _StressBarrier(v, f, conn.edges, np.linalg.norm(v[conn.edges[:, 1]] - v[conn.edges[:, 0]], axis=1))
+    value, _ = flat(v[:, :2].copy(), 1.0)
+    assert value == pytest.approx(2 * flat.w.sum(), rel=1e-12)
+    assert flat.w.sum() == pytest.approx(0.75 * len(f), rel=1e-12)
+
+
+@pytest.mark.parametrize("name", ["bff_bunnyhead.obj", "bff_spothead.obj"])
+def test_heads_relax_far_below_their_conformal_start(name):
+    """On heads the greedy grower folds; the relaxation starts from LSCM, whose
+    ears are shrunk many times, and must open them up without folding."""
+    from .conftest import CORPUS
+
+    path = CORPUS / name
+    if not path.is_file():
+        pytest.skip(f"corpus mesh {path} is absent")
+    mesh = read_mesh(path)
+    v, f, conn = validate_mesh(mesh.vertices, mesh.faces)
+    start = lscm(v, f, conn)
+    start = start * best_scale(v, conn.edges, start)
+    start_rms = patterns.distortion(v, f, start).edge_strain_rms
+    r = patterns.flatten_mesh(v, f)
+    assert r.start == "lscm" and r.one_to_one and r.n_folded == 0 and r.converged
+    assert independent_one_to_one(r.faces, r.uv)
+    # Measured: 0.366 of 0.80 (bunny), 0.336 of 1.00 (spot); libigl SLIM gets
+    # 0.83 and 0.78, libigl ARAP 0.45 (264 folded) and 0.53 (no fold).
+    assert r.distortion.edge_strain_rms < 0.55 * start_rms
+    assert r.distortion.edge_strain_rms < 0.45

@@ -2,20 +2,34 @@
 
 The relaxation minimises the edge-length stress
 
-    E(u) = sum over edges of (|u_i - u_j| / l_ij - 1)**2,
+    S(u) = sum over edges of (|u_i - u_j| / l_ij - 1)**2,
 
-the sum of squared edge strains, by stress majorization (SMACOF): each
-iteration aims every edge at its true 3D length along its current direction and
-solves one sparse linear system whose matrix (the graph Laplacian weighted by
-``1 / l**2``) never changes, so it is factorised once.
+the sum of squared edge strains, while every triangle keeps its orientation and
+the flat boundary never crosses itself.
 
-The layout stays one-to-one at every iterate.  The step towards the solution is
-cut, vertex by vertex, so that (1) no triangle's orientation flips (the largest
-flip-free fraction of each triangle's step is solved for exactly) and (2) the
-flat boundary loops stay a valid polygon (crossing boundary segments, found with
-a shapely STRtree, have their vertices' steps cut).  A start without folds and
-with valid loops therefore ends without folds and without overlap, by the same
-degree argument as :mod:`patterns.check`.  Nothing is ever rescaled.
+Method
+------
+* **Energy.**  ``E = S + mu * B`` with the collapse barrier
+  ``B = sum_t w_t |J_t^-1|_F**2`` (``J_t`` the triangle's Jacobian from its 3D
+  frame to the plane; 2 for a rigid motion, unbounded as a triangle
+  collapses).  ``mu`` starts at ``barrier`` and is cut tenfold each time
+  progress stalls; the last stage has ``mu = 0`` and minimises the stress
+  alone.  The barrier matters when the start is far from the answer (a
+  conformal layout of a head, whose ears are shrunk a hundredfold): without it
+  the stress squeezes triangles flat on the way and the steps stall.
+* **Steps.**  L-BFGS whose initial inverse Hessian is ``L^-1 / 2``, ``L`` the
+  graph Laplacian with weights ``1 / l**2`` (the stress's curvature at the
+  answer), factorised once with SuperLU.  While the barrier is strong its
+  curvature is added to the weights every few iterations and the matrix
+  refactorised (a scalar version of SLIM's proxy).  One solve per iteration.
+* **Line search.**  Each step is capped at 0.9 of the first time any triangle
+  would flip (exact quadratic roots, :func:`flip_free_steps`), then halved until
+  the energy drops (Armijo) and the boundary loops are still a valid polygon
+  (shapely).  A start without folds and with valid loops therefore ends
+  without folds and without overlap, by the same degree argument as
+  :mod:`patterns.check`.  Nothing is ever rescaled.
+* **Pins** are reached first by stress-majorization steps cut vertex by vertex
+  (:func:`_travel_to_pins`), then held while the rest relaxes.
 """
 
 from __future__ import annotations
@@ -27,9 +41,15 @@ import scipy.sparse as sp
 import shapely
 
 from ..errors import InputError
-from ..measure import signed_areas
+from ..measure import local_coordinates, signed_areas
 from ..mesh import Connectivity
 from .embed import factorize
+
+_WINDOW = 2  # iterations over which progress is judged
+_STAGE_TOLERANCE = 30.0  # a barrier stage ends at this many times the tolerance
+_REFRESH = 5  # iterations between refactorisations while the barrier is strong
+_MEMORY = 8  # L-BFGS pairs kept
+_WEAKEST = 1e-5  # the last barrier stage before the stress alone
 
 __all__ = ["Relaxation", "align_to_pins", "best_scale", "flip_free_steps", "relax"]
 
@@ -127,8 +147,11 @@ def align_to_pins(uv: np.ndarray, index: np.ndarray, target: np.ndarray) -> np.n
 
 
 def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np.ndarray, *,
-          pins=None, max_iterations: int = 50, tolerance: float = 1e-4, progress=None) -> Relaxation:
+          pins=None, barrier: float = 1e-3, max_iterations: int = 500, tolerance: float = 1e-4,
+          progress=None) -> Relaxation:
     """Relax a one-to-one layout towards true edge lengths, keeping it one-to-one.
+
+    See the module docstring for the method.
 
     Parameters
     ----------
@@ -139,12 +162,17 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         A layout without folded triangles and with valid boundary loops.
     pins : tuple of ((k,) int, (k, 2) float), optional
         Vertices to hold and their flat positions (libigl's ``b, bc``).  They
-        are approached step by step; if reaching them would fold or overlap the
-        pattern they stop short (``converged`` is then False).
+        are approached step by step first; if reaching them would fold or
+        overlap the pattern they stop short (``converged`` is then False).
+    barrier : float
+        Starting barrier weight ``mu`` (>= 0): 0.1 for a start far from the
+        answer (a conformal or Tutte layout), 1e-3 for a near one (the greedy
+        layout); 0 minimises the stress alone from the start.
     max_iterations : int
-        > 0.
+        > 0; pin travel and quasi-Newton iterations together.
     tolerance : float
-        Stop when an iteration lowers the stress by less than this fraction.
+        Stop when the stress falls by less than this fraction per iteration
+        (averaged over two); a barrier stage ends at 30 times this.
     progress : callable, optional
         ``progress(iteration, max_iterations)`` after each iteration.
 
@@ -164,72 +192,261 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     adjacency = sp.coo_matrix((np.r_[weight, weight], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])),
                               shape=(n, n)).tocsr()
     laplacian = (sp.diags(np.asarray(adjacency.sum(axis=1)).ravel()) - adjacency).tocsr()
-
     free = np.ones(n, dtype=bool)
     if pins is None:
-        # The stress does not see translations: hold vertex 0 softly where it
-        # starts.  The stress forces sum to zero, so at a fixed point the
-        # anchor carries no force and does not bias the result.
-        pin_index = np.zeros(0, dtype=np.int64)
-        pin_target = np.zeros((0, 2))
-        anchor = float(weight.mean())
-        system = laplacian + sp.coo_matrix(([anchor], ([0], [0])), shape=(n, n))
-        anchor_at = uv[0].copy()
+        # The stress does not see translations: tie vertex 0 softly.  For the
+        # preconditioner only; the energy itself has no anchor term.
+        anchor = sp.coo_matrix(([float(weight.mean())], ([0], [0])), shape=(n, n))
+        system = laplacian + anchor
+        iterations = 0
     else:
         pin_index, pin_target = pins
         free[pin_index] = False
-        anchor = 0.0
         system = laplacian[free][:, free]
-        coupling = laplacian[free][:, ~free]
+        uv, iterations = _travel_to_pins(faces, conn.loops, e, length, weight, laplacian, free, uv, pin_index,
+                                         pin_target, max_iterations, progress)
+        if not np.allclose(uv[pin_index], pin_target, rtol=0, atol=1e-9 * _size(uv)):
+            uv.setflags(write=False)
+            return Relaxation(uv, iterations, False)
+        uv[pin_index] = pin_target
     lu = factorize(system)
+    energy = _StressBarrier(vertices, faces, e, length)
 
-    def majorize(u):
-        """The majorizer's minimiser from ``u``, and the stress at ``u``."""
+    def refactor(u, mu):
+        """The Laplacian with the barrier's curvature added to its weights, factorised."""
+        stiff = energy.barrier_stiffness(u, mu)
+        extra = np.zeros(len(e))
+        for k in range(3):
+            extra += np.bincount(conn.face_edges[:, k], stiff, len(e))
+        if np.mean(extra > 1.0) < 0.1:
+            # The barrier at most doubles the curvature of under a tenth of the
+            # edges (a few squeezed triangles): not worth a factorisation.
+            return lu
+        w = weight * (1.0 + 0.5 * extra)
+        adj = sp.coo_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), shape=(n, n)).tocsr()
+        lap = (sp.diags(np.asarray(adj.sum(axis=1)).ravel()) - adj).tocsr()
+        lap = lap[free][:, free] if pins is not None else lap + anchor
+        return factorize(lap)
+
+    uv, used, converged = _quasi_newton(energy, faces, conn.loops, uv, free, lu, refactor=refactor, barrier=barrier,
+                                        max_iterations=max_iterations - iterations, tolerance=tolerance,
+                                        floor=floor, progress=progress, offset=iterations,
+                                        total=max_iterations)
+    uv.setflags(write=False)
+    return Relaxation(uv, iterations + used, converged)
+
+
+class _StressBarrier:
+    """Edge stress plus ``mu`` times a collapse barrier, and its gradient.
+
+    ``E(u) = sum_e (|u_i - u_j| / l_e - 1)**2 + mu * sum_t w_t |J_t^-1|_F**2``
+    with ``J_t`` the triangle's 2x2 Jacobian from its 3D frame to the plane and
+    ``w_t`` its 3D area over the mean area, times 0.75 (the barrier term of a
+    mesh then counts about as many terms as the stress, half as many as edges).
+    ``|J^-1|_F**2 = |J|_F**2 / det(J)**2`` is 2 for a rigid motion and grows
+    without bound as the triangle collapses.
+    """
+
+    def __init__(self, vertices, faces, edges, length):
+        n = len(vertices)
+        self.faces, self.edges, self.length = faces, edges, length
+        z = local_coordinates(vertices, faces)
+        r1, r2 = z[:, 1] - z[:, 0], z[:, 2] - z[:, 0]
+        # R = [[r1.x, r2.x], [r1.y, r2.y]]; G = R^-1 R^-T (symmetric).
+        det_r = r1.real * r2.imag - r2.real * r1.imag
+        i11, i12, i21, i22 = r2.imag / det_r, -r2.real / det_r, -r1.imag / det_r, r1.real / det_r
+        self.g11, self.g12, self.g22 = i11 * i11 + i12 * i12, i11 * i21 + i12 * i22, i21 * i21 + i22 * i22
+        self.det_r2 = det_r * det_r
+        area = 0.5 * np.abs(det_r)
+        self.w = 0.75 * area / area.mean()
+        ne, m = len(edges), len(faces)
+        # Sparse scatter matrices: per-edge and per-triangle-column gradients to vertices.
+        self.edge_scatter = sp.csr_matrix((np.r_[np.ones(ne), -np.ones(ne)],
+                                           (np.r_[edges[:, 1], edges[:, 0]], np.r_[np.arange(ne), np.arange(ne)])),
+                                          shape=(n, ne))
+        cols = np.arange(2 * m)
+        self.face_scatter = sp.csr_matrix(
+            (np.r_[np.ones(2 * m), -np.ones(2 * m)],
+             (np.r_[faces[:, 1], faces[:, 2], faces[:, 0], faces[:, 0]], np.r_[cols, cols])), shape=(n, 2 * m))
+
+    def barrier_stiffness(self, u, mu):
+        """Per-triangle curvature scale of the barrier term, ``(m,)``: ``mu w 6 / sigma_min**4``."""
+        f = self.faces
+        x, y = u[:, 0], u[:, 1]
+        a, c = x[f[:, 1]] - x[f[:, 0]], y[f[:, 1]] - y[f[:, 0]]
+        b, dd = x[f[:, 2]] - x[f[:, 0]], y[f[:, 2]] - y[f[:, 0]]
+        det2 = (a * dd - b * c) ** 2 / self.det_r2  # det(J)**2
+        norm_j = a * (a * self.g11 + b * self.g12) + b * (a * self.g12 + b * self.g22) + \
+            c * (c * self.g11 + dd * self.g12) + dd * (c * self.g12 + dd * self.g22)
+        # Smallest singular value squared, in the cancellation-free form
+        # det**2 / (largest one squared).
+        smin2 = 2.0 * det2 / (norm_j + np.sqrt(np.maximum(norm_j * norm_j - 4.0 * det2, 0.0)))
+        with np.errstate(divide="ignore", over="ignore"):
+            return np.minimum(mu * self.w * 6.0 / (smin2 * smin2), 1e12)
+
+    def __call__(self, u, mu):
+        """``(E, gradient (n, 2))``; ``(inf, None)`` if ``mu > 0`` and a triangle is folded."""
+        e = self.edges
         d = u[e[:, 1]] - u[e[:, 0]]
+        dl = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2)
+        r = dl / self.length - 1.0
+        grad = self.edge_scatter @ (d * (2.0 * r / (self.length * np.maximum(dl, 1e-300)))[:, None])
+        value = float(r @ r)
+        if mu == 0:
+            return value, grad
+        f = self.faces
+        x, y = u[:, 0], u[:, 1]
+        a, c = x[f[:, 1]] - x[f[:, 0]], y[f[:, 1]] - y[f[:, 0]]  # P = [[a, b], [c, d]]
+        b, dd = x[f[:, 2]] - x[f[:, 0]], y[f[:, 2]] - y[f[:, 0]]
+        det_p = a * dd - b * c
+        if not np.all(det_p > 0):
+            return np.inf, None
+        pg11, pg12 = a * self.g11 + b * self.g12, a * self.g12 + b * self.g22
+        pg21, pg22 = c * self.g11 + dd * self.g12, c * self.g12 + dd * self.g22
+        norm_j = a * pg11 + b * pg12 + c * pg21 + dd * pg22  # |J|^2 (times nothing: G carries R)
+        s = self.det_r2 / (det_p * det_p)
+        value += mu * float(self.w @ (norm_j * s))
+        k1 = (2.0 * mu) * self.w * s
+        k2 = k1 * norm_j / det_p
+        # d/dP of |J|^2 det_r^2 / det_p^2 = 2 P G s - 2 |J|^2 s / det_p * cof(P),
+        # cof(P) = [[dd, -c], [-b, a]].
+        col0 = np.column_stack([k1 * pg11 - k2 * dd, k1 * pg21 + k2 * b])
+        col1 = np.column_stack([k1 * pg12 + k2 * c, k1 * pg22 - k2 * a])
+        grad = grad + self.face_scatter @ np.concatenate([col0, col1])
+        return value, grad
+
+
+def _quasi_newton(energy, faces, loops, uv, free, lu, *, refactor, barrier, max_iterations, tolerance, floor,
+                  progress, offset, total):
+    """L-BFGS with a Laplacian ``H0`` and a flip-free, non-crossing line search.
+
+    ``H0 = A^-1 / 2`` with ``A`` the stress Laplacian (plus the barrier's
+    curvature while the barrier is on, refreshed every ``_REFRESH``
+    iterations), scaled by the latest ``s.y / y.H0 y``.  ``H0`` is applied to
+    each accepted gradient once and kept, so that the two-loop recursion needs
+    no further solve.  Returns ``(uv, iterations, converged)``.
+    """
+    size = _size(uv)
+    mu = float(barrier)
+
+    def evaluate(u):
+        value, grad = energy(u, mu)
+        return value, (None if grad is None else grad[free])
+
+    value, grad = evaluate(uv)
+    base = lu
+    since_refresh = _REFRESH  # refresh at once if the barrier is on
+    history = []  # (s, y, H0 y)
+    recent = [value]
+    iterations = 0
+    converged = False
+    hgrad = None
+    while iterations < max_iterations:
+        iterations += 1
+        if mu > 0 and since_refresh >= _REFRESH:
+            lu, since_refresh = refactor(uv, mu), 0
+            hgrad, history = None, []
+        since_refresh += 1
+        if hgrad is None:
+            hgrad = 0.5 * lu.solve(grad)
+        direction = np.zeros_like(uv)
+        direction[free] = -_two_loop(grad, hgrad, history)
+        slope = float(np.sum(grad * direction[free]))
+        if not slope < 0:  # stale memory: fall back to the preconditioned gradient
+            history = []
+            direction[free] = -hgrad
+            slope = float(np.sum(grad * direction[free]))
+        step = min(1.0, 0.9 * float(flip_free_steps(faces, uv, direction, horizon=1.0 / 0.9).min()))
+        # Steps below round-off of the layout's size make no progress.
+        smallest = 1e-13 * size / max(float(np.abs(direction).max()), 1e-300)
+        moved = False
+        while step > smallest:
+            cand = uv + step * direction
+            new_value, new_grad = evaluate(cand)
+            if new_value <= value + 1e-4 * step * slope and _boundary_crossings(cand, loops) is None:
+                moved = True
+                break
+            step *= 0.5
+        if moved:
+            new_hgrad = 0.5 * lu.solve(new_grad)
+            s, y = (cand - uv)[free], new_grad - grad
+            if float(np.sum(s * y)) > 0:
+                history.append((s, y, new_hgrad - hgrad))
+                del history[:-_MEMORY]
+            uv, value, grad, hgrad = cand, new_value, new_grad, new_hgrad
+        if progress is not None:
+            progress(offset + iterations, total)
+        if not moved and history:
+            history = []  # retry once from the plain preconditioned gradient
+            continue
+        last = mu == 0.0
+        # Progress is judged over a window of iterations: single quasi-Newton
+        # steps vary too much (a short step is often followed by a long one).
+        recent.append(value)
+        gain = recent[0] - value if len(recent) > _WINDOW else np.inf
+        del recent[:-_WINDOW - 1]
+        stalled = not moved or gain <= _WINDOW * tolerance * (1.0 if last else _STAGE_TOLERANCE) * value
+        if last and (stalled or value <= floor):
+            converged = True
+            break
+        if stalled:  # next stage: a tenth of the barrier, or none
+            mu = mu * 0.1 if mu > _WEAKEST * 1.5 else 0.0
+            value, grad = evaluate(uv)
+            lu, since_refresh = (refactor(uv, mu) if mu > 0 else base), 0
+            hgrad, history, recent = None, [], [value]
+    return uv, iterations, converged
+
+
+def _two_loop(grad, hgrad, history):
+    """L-BFGS two-loop recursion; ``H0`` products come precomputed (``hgrad``, ``H0 y``)."""
+    alphas = []
+    for s, y, _ in reversed(history):
+        alphas.append(float(np.sum(s * grad)) / float(np.sum(y * s)))
+        grad = grad - alphas[-1] * y
+    # H0 q = H0 g - sum a_i H0 y_i (H0 is linear).
+    r = hgrad.copy()
+    for (_, _, hy), a in zip(reversed(history), alphas):
+        r -= a * hy
+    if history:
+        s, y, hy = history[-1]
+        r *= float(np.sum(s * y)) / float(np.sum(y * hy))
+    for (s, y, _), a in zip(history, reversed(alphas)):
+        b = float(np.sum(y * r)) / float(np.sum(y * s))
+        r += (a - b) * s
+    return r
+
+
+def _travel_to_pins(faces, loops, e, length, weight, laplacian, free, uv, pin_index, pin_target,
+                    max_iterations, progress):
+    """Move the pins onto their targets by stress-majorization steps, staying one-to-one.
+
+    Each step aims at the minimiser of the stress's majorizer with the pins at
+    their targets (one solve with the Laplacian's free block), cut vertex by
+    vertex so nothing folds or crosses.  Returns ``(uv, iterations)``.
+    """
+    n = len(uv)
+    lu = factorize(laplacian[free][:, free])
+    coupling = laplacian[free][:, ~free]
+    size = _size(uv)
+    iterations = 0
+    while iterations < max_iterations and not np.allclose(uv[pin_index], pin_target, rtol=0, atol=1e-9 * size):
+        iterations += 1
+        d = uv[e[:, 1]] - uv[e[:, 0]]
         dl = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2)
         q = d * (weight * length / np.maximum(dl, 1e-300))[:, None]
         rhs = np.empty((n, 2))
         for k in range(2):
             rhs[:, k] = np.bincount(e[:, 1], q[:, k], n) - np.bincount(e[:, 0], q[:, k], n)
         target = np.empty((n, 2))
-        if anchor:
-            rhs[0] += anchor * anchor_at
-            target[:] = lu.solve(rhs)
-        else:
-            target[~free] = pin_target
-            target[free] = lu.solve(rhs[free] - coupling @ pin_target)
-        return target, float(np.sum((dl / length - 1.0) ** 2))
-
-    def pins_reached(u):
-        return np.allclose(u[pin_index], pin_target, rtol=0, atol=1e-9 * _size(u))
-
-    target, energy = majorize(uv)
-    best, best_energy = uv, energy
-    converged = False
-    iterations = 0
-    for iterations in range(1, max_iterations + 1):
-        moved = _safe_move(faces, conn.loops, uv, target)
-        stuck = moved is uv
-        target, new_energy = majorize(moved)
-        # Converged: the stress changed by less than the tolerance (either way:
-        # round-off moves it both ways), or the edge strain is at round-off
-        # level already (RMS below 1e-10: an exactly developable part, where the
-        # round-off of a million-face layout reaches 1e-11).
-        small = abs(energy - new_energy) <= tolerance * energy or new_energy <= floor
-        uv, energy = moved, new_energy
-        # Cut steps are not guaranteed to lower the stress: keep the best
-        # iterate (while the pins are still travelling, the latest).
-        if energy <= best_energy or len(pin_index):
-            best, best_energy = uv, energy
+        target[~free] = pin_target
+        target[free] = lu.solve(rhs[free] - coupling @ pin_target)
+        moved = _safe_move(faces, loops, uv, target)
         if progress is not None:
             progress(iterations, max_iterations)
-        if stuck or (small and pins_reached(uv)):
-            converged = not stuck or energy == 0.0
+        if moved is uv:
             break
-    uv = best
-    converged = converged and pins_reached(uv)
-    uv.setflags(write=False)
-    return Relaxation(uv, iterations, converged)
+        uv = moved
+    return np.array(uv), iterations
 
 
 def _size(uv: np.ndarray) -> float:
