@@ -3,6 +3,10 @@
 The public API, all importable from the top level::
 
     import patterns
+    model = patterns.load("duct.step")                # or a mesh file, or a build123d shape
+    pattern = patterns.flatten(model)                 # every panel flat, 1:1, seams kept
+    pattern.panels[0].uv, pattern.seams[0].flat_lengths
+
     result = patterns.flatten_mesh(vertices, faces)   # (n, 3), (m, 3) arrays in
     result.uv                                         # (n, 2) flat positions, 1:1
     result.overlap.one_to_one, result.distortion.edge_strain_rms
@@ -17,10 +21,14 @@ from .errors import (
     MeshTopologyError,
     PatternsError,
 )
-from .flatten import METHODS, Flattening, flatten_mesh
+from .cut import Cut, cut_to_disk
+from .flatten import METHODS, Flattening, flatten, flatten_mesh
+from .load import load, read_cad, read_mesh
 from .measure import Distortion, distortion
 from .mesh import Connectivity, validate_mesh
-from .tessellate import tessellate_face
+from .model import Model, Panel, Seam
+from .pattern import FlatPanel, FlatSeam, Pattern
+from .tessellate import mesh_shape, tessellate_face
 
 __version__ = "0.1.0"
 
@@ -28,18 +36,31 @@ __all__ = [
     "METHODS",
     "CadError",
     "Connectivity",
+    "Cut",
     "Distortion",
     "ExportError",
     "FlattenError",
+    "FlatPanel",
+    "FlatSeam",
     "Flattening",
     "InputError",
     "MeshTopologyError",
+    "Model",
     "Overlap",
+    "Panel",
+    "Pattern",
     "PatternsError",
+    "Seam",
     "__version__",
+    "cut_to_disk",
     "distortion",
+    "flatten",
     "flatten_mesh",
+    "load",
+    "mesh_shape",
     "overlap_verdict",
+    "read_cad",
+    "read_mesh",
     "tessellate_face",
     "validate_mesh",
 ]

@@ -36,7 +36,7 @@ def _parser() -> argparse.ArgumentParser:
                       help="output: .dxf (cut contours on layer CUT) or .obj (flat mesh, z = 0)")
     flat.add_argument("--method", choices=METHODS, default="relaxed", help="flattening method (default relaxed)")
     flat.add_argument("--seed-face", type=int, default=None, help="face laid down first (default: farthest from the boundary)")
-    flat.add_argument("--max-iterations", type=int, default=50, help="relaxation iterations at most (default 50)")
+    flat.add_argument("--max-iterations", type=int, default=500, help="relaxation iterations at most (default 500)")
     flat.add_argument("--units", choices=tuple(UNITS), default="mm", help="unit of the input coordinates (default mm)")
     return parser
 

@@ -1,4 +1,12 @@
-"""Reading meshes from files.
+"""Loading: CAD files, mesh files and build123d objects become a :class:`~patterns.Model`.
+
+:func:`load` is the entry point.  CAD files (STEP, BREP, IGES) and build123d
+objects are meshed by :func:`patterns.tessellate.mesh_shape`: one panel per CAD
+face (or per named group of faces), seams where two panels share a CAD edge.
+Mesh files are split into connected pieces, one panel each; a closed piece or a
+tube is cut open (:func:`patterns.cut.cut_to_disk`) and the cut reported as a
+seam.
+
 
 Mesh files (.obj, .stl, .ply, .off) are read by trimesh with ``process=False``:
 trimesh never merges or drops anything silently.  Indexed formats (OBJ, PLY,
@@ -16,13 +24,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .mesh import as_mesh_arrays
+from .errors import CadError, InputError
+from .mesh import as_mesh_arrays, validate_mesh
 
-__all__ = ["MESH_SUFFIXES", "MeshFile", "drop_unused", "read_mesh", "weld"]
+__all__ = ["CAD_SUFFIXES", "MESH_SUFFIXES", "MeshFile", "drop_unused", "load", "mesh_model", "read_cad", "read_mesh", "weld"]
 
-MESH_SUFFIXES = (".obj", ".stl", ".ply", ".off")
+MESH_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".3mf")
 """File suffixes :func:`read_mesh` reads."""
+
+CAD_SUFFIXES = (".step", ".stp", ".brep", ".brp", ".iges", ".igs")
+"""File suffixes :func:`read_cad` reads."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,10 +113,11 @@ def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
     Parameters
     ----------
     path : str or Path
-        An .obj, .stl, .ply or .off file.
+        An .obj, .stl, .ply, .off or .3mf file.
     weld_vertices : bool, optional
         Merge vertices at identical coordinates.  Default: only for STL, which
-        has no shared vertices.  Unused vertices are always dropped.
+        has no shared vertices, and 3MF (its reader leaves them split).  Unused
+        vertices are always dropped.
 
     Returns
     -------
@@ -137,7 +149,7 @@ def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
         raise InputError(f"{path}: the file holds no triangles")
     vertices, faces = as_mesh_arrays(loaded.vertices, loaded.faces, name=str(path))
     if weld_vertices is None:
-        weld_vertices = suffix == ".stl"
+        weld_vertices = suffix in (".stl", ".3mf")
     if weld_vertices:
         vertices, faces, n_welded, n_unused = weld(vertices, faces)
     else:
@@ -146,3 +158,163 @@ def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
     vertices.setflags(write=False)
     faces.setflags(write=False)
     return MeshFile(vertices, faces, path, n_welded, n_unused)
+
+
+def read_cad(path):
+    """Read a STEP, BREP or IGES file into an OpenCascade shape (millimetres).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    OCP.TopoDS.TopoDS_Shape
+        STEP and IGES are converted to millimetres by OpenCascade's readers;
+        BREP carries no unit and is taken as millimetres.
+
+    Raises
+    ------
+    InputError
+        Missing file or unknown suffix.
+    CadError
+        The file is empty, corrupt, or holds no shape.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in CAD_SUFFIXES:
+        raise InputError(f"{path}: unknown CAD file type {suffix or '(none)'!r}; "
+                         f"expected one of {', '.join(CAD_SUFFIXES)}")
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    if path.stat().st_size == 0:
+        raise CadError(f"{path}: the file is empty")
+    from OCP.IFSelect import IFSelect_RetDone
+
+    kind = {".step": "STEP", ".stp": "STEP", ".iges": "IGES", ".igs": "IGES"}.get(suffix, "BREP")
+    try:
+        if kind == "BREP":
+            from OCP.BRep import BRep_Builder
+            from OCP.BRepTools import BRepTools
+            from OCP.TopoDS import TopoDS_Shape
+
+            shape = TopoDS_Shape()
+            ok = BRepTools.Read_s(shape, str(path), BRep_Builder())
+        else:
+            if kind == "STEP":
+                from OCP.STEPControl import STEPControl_Reader as Reader
+            else:
+                from OCP.IGESControl import IGESControl_Reader as Reader
+            reader = Reader()
+            ok = reader.ReadFile(str(path)) == IFSelect_RetDone
+            if ok:
+                reader.TransferRoots()
+                shape = reader.OneShape()
+    except Exception as exc:  # noqa: BLE001 - OpenCascade raises many kinds
+        raise CadError(f"{path}: cannot read this {kind} file ({type(exc).__name__}: {exc})") from None
+    if not ok:
+        raise CadError(f"{path}: not a readable {kind} file (corrupt, truncated or another format)")
+    if shape is None or shape.IsNull():
+        raise CadError(f"{path}: the {kind} file holds no shape")
+    return shape
+
+
+def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max_edge: float | None = None,
+         faces=None, weld_vertices: bool | None = None):
+    """Load a part as panels joined by seams.
+
+    Parameters
+    ----------
+    source : str, Path or build123d shape
+        A CAD file (.step/.stp, .brep, .iges/.igs), a mesh file (.stl, .obj,
+        .ply, .off, .3mf), or a build123d ``Face``, ``Shell``, ``Solid``,
+        ``Compound`` or ``Part``.  Millimetres.
+    tolerance : float
+        CAD only: largest distance from the mesh to the true surface, mm (> 0).
+    angular_tolerance : float
+        CAD only: largest angle between the normals at the two ends of a mesh
+        edge, radians (> 0).
+    max_edge : float, optional
+        CAD only: target edge length, mm (> 0); default from the part's area
+        (about 4000 triangles).  Curved faces and edges get shorter ones to meet
+        the tolerances.
+    faces : mapping of str to list of int, optional
+        CAD only: groups of CAD faces (indices in ``shape.faces()`` order) to
+        cut as one panel each, e.g. ``{"front": [0, 1], "back": [2, 3]}``.
+    weld_vertices : bool, optional
+        Mesh files only: see :func:`read_mesh`.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    InputError
+        Missing file, unknown suffix, bad values in a mesh, bad options.
+    CadError
+        Empty, corrupt or face-less CAD file; a face that cannot be meshed.
+    MeshTopologyError
+        A mesh piece that is non-manifold, inconsistently wound, or has handles.
+    """
+    from .tessellate import mesh_shape
+
+    if isinstance(source, (str, Path)):
+        path = Path(source)
+        suffix = path.suffix.lower()
+        if suffix in CAD_SUFFIXES:
+            if weld_vertices is not None:
+                raise InputError(f"{path}: weld_vertices applies to mesh files only")
+            return mesh_shape(read_cad(path), max_edge=max_edge, tolerance=tolerance,
+                              angular_tolerance=angular_tolerance, faces=faces, name=path.name)
+        if suffix in MESH_SUFFIXES:
+            if faces is not None:
+                raise InputError(f"{path}: faces (groups of CAD faces) apply to CAD files only")
+            mesh = read_mesh(path, weld_vertices=weld_vertices)
+            return mesh_model(mesh.vertices, mesh.faces, name=path.name)
+        if not path.exists():
+            raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: unknown file type {suffix or '(none)'!r}; expected a CAD file "
+                         f"({', '.join(CAD_SUFFIXES)}) or a mesh file ({', '.join(MESH_SUFFIXES)})")
+    if hasattr(source, "wrapped"):
+        return mesh_shape(source, max_edge=max_edge, tolerance=tolerance, angular_tolerance=angular_tolerance,
+                          faces=faces, name=type(source).__name__)
+    raise InputError(f"cannot load a {type(source).__name__}: give a file path or a build123d shape")
+
+
+def mesh_model(vertices, faces, *, name: str = "mesh"):
+    """A :class:`Model` from a triangle mesh: one panel per connected piece, cut open where needed.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float, mm
+    faces : (m, 3) int
+    name : str
+
+    Returns
+    -------
+    Model
+        Panels ``piece0``, ``piece1``, ... in order of their first face;
+        seams are the cuts (``cad_edge`` None, both sides on one panel).
+    """
+    from .cut import cut_to_disk, pieces
+    from .model import Model, Panel, Seam
+
+    v, f = as_mesh_arrays(vertices, faces, name=name)
+    panels, seams = [], []
+    groups = pieces(f, len(v))
+    for i, group in enumerate(groups):
+        label = f"piece{i}"
+        pname = name if len(groups) == 1 else f"{name}: {label}"
+        pv, pf, _ = drop_unused(v, f[group])
+        cut = cut_to_disk(pv, pf, name=pname)
+        cv, cf, conn = validate_mesh(cut.vertices, cut.faces, name=pname)
+        loops = sorted(conn.loops, key=lambda lp: -np.linalg.norm(cv[np.roll(lp, -1)] - cv[lp], axis=1).sum())
+        panels.append(Panel(label, cv, cf, tuple(loops)))
+        for path, (left, right) in zip(cut.paths, cut.sides):
+            points = pv[path]
+            seams.append(Seam(id=len(seams), panels=(i, i), points=points, vertices=(left, right),
+                              length=float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())))
+    edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    longest = float(np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1).max())
+    return Model(name=name, panels=tuple(panels), seams=tuple(seams), max_edge=longest)

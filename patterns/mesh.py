@@ -23,9 +23,13 @@ from .errors import InputError, MeshTopologyError
 
 __all__ = [
     "Connectivity",
+    "EdgeTables",
     "as_mesh_arrays",
     "boundary_loops",
+    "check_boundary_vertices",
+    "edge_tables",
     "face_areas",
+    "trace_loops",
     "validate_mesh",
 ]
 
@@ -144,6 +148,104 @@ def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(a, b), axis=1)
 
 
+@dataclass(frozen=True, eq=False)
+class EdgeTables:
+    """Edges of a mesh that is manifold and consistently wound (not necessarily a disk).
+
+    Attributes
+    ----------
+    edges : (e, 2) int64
+        Unique undirected edges, ``edges[:, 0] < edges[:, 1]``, sorted.
+    face_edges : (m, 3) int64
+        Edge of each face side, corner ``k`` to ``k + 1``.
+    edge_faces : (e, 2) int64
+        Faces on either side; ``-1`` on the boundary side.
+    boundary_from, boundary_to : (b,) int64
+        Directed boundary edges, the surface on their left.
+    """
+
+    edges: np.ndarray
+    face_edges: np.ndarray
+    edge_faces: np.ndarray
+    boundary_from: np.ndarray
+    boundary_to: np.ndarray
+
+
+def edge_tables(faces: np.ndarray, n_vertices: int, *, name: str = "mesh") -> EdgeTables:
+    """Edge tables of a triangle mesh, checking that it is manifold and consistently wound.
+
+    Parameters
+    ----------
+    faces : (m, 3) int64
+        Valid indices into ``n_vertices`` vertices.
+    n_vertices : int
+    name : str
+        For error messages.
+
+    Raises
+    ------
+    MeshTopologyError
+        An edge shared by more than two faces, or inconsistent winding.  (A
+        vertex the boundary passes through twice is checked separately, by
+        :func:`check_boundary_vertices`.)
+    """
+    f, n, m = faces, n_vertices, len(faces)
+    # Half-edges k: corner k -> corner k+1 of each face.
+    a = f.ravel()
+    b = f[:, [1, 2, 0]].ravel()
+    lo = np.minimum(a, b)
+    hi = np.maximum(a, b)
+    keys = lo * n + hi
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    first = np.ones(len(keys), dtype=bool)
+    first[1:] = sorted_keys[1:] != sorted_keys[:-1]
+    starts = np.flatnonzero(first)
+    counts = np.diff(np.append(starts, len(keys)))
+    edge_id_sorted = np.cumsum(first) - 1
+    face_edges = np.empty(len(keys), dtype=np.int64)
+    face_edges[order] = edge_id_sorted
+    face_edges = face_edges.reshape(m, 3)
+    edges = np.stack([lo[order[starts]], hi[order[starts]]], axis=1)
+
+    if (counts > 2).any():
+        e = int(np.flatnonzero(counts > 2)[0])
+        raise MeshTopologyError(
+            f"{name}: {int((counts > 2).sum())} non-manifold edges shared by more than two faces "
+            f"(first: edge {edges[e].tolist()}, {int(counts[e])} faces)"
+        )
+    # Each interior edge must be used once in each direction.
+    forward = (a < b)[order]
+    interior = counts == 2
+    fwd_sum = np.add.reduceat(forward.astype(np.int64), starts)
+    bad_winding = interior & (fwd_sum != 1)
+    if bad_winding.any():
+        e = int(np.flatnonzero(bad_winding)[0])
+        raise MeshTopologyError(
+            f"{name}: faces are not consistently wound ({int(bad_winding.sum())} edges are "
+            f"used twice in the same direction, first: edge {edges[e].tolist()}); "
+            f"orient the faces consistently first"
+        )
+    face_of = order // 3
+    edge_faces = np.full((len(edges), 2), -1, dtype=np.int64)
+    edge_faces[:, 0] = face_of[starts]
+    edge_faces[interior, 1] = face_of[starts[interior] + 1]
+    # Directed boundary edges, oriented with the surface to their left.
+    bh = order[starts[~interior]]
+    return EdgeTables(edges, face_edges, edge_faces, a[bh], b[bh])
+
+
+def check_boundary_vertices(tables: EdgeTables, n_vertices: int, *, name: str = "mesh") -> None:
+    """Raise :class:`MeshTopologyError` if the boundary passes through a vertex more than once."""
+    out_degree = np.bincount(tables.boundary_from, minlength=n_vertices)
+    if (out_degree > 1).any():
+        vtx = int(np.flatnonzero(out_degree > 1)[0])
+        raise MeshTopologyError(
+            f"{name}: non-manifold vertex {vtx} (the boundary passes through it "
+            f"{int(out_degree[vtx])} times); split it first"
+        )
+
+
 def validate_mesh(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, np.ndarray, Connectivity]:
     """Check that a mesh is a connected, consistently wound planar domain.
 
@@ -192,48 +294,9 @@ def validate_mesh(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, n
             f"(first: vertex {int(np.flatnonzero(~used)[0])}); remove them first"
         )
 
-    # Half-edges k: corner k -> corner k+1 of each face.
-    a = f.ravel()
-    b = f[:, [1, 2, 0]].ravel()
-    lo = np.minimum(a, b)
-    hi = np.maximum(a, b)
-    keys = lo * n + hi
-    order = np.argsort(keys, kind="stable")
-    sorted_keys = keys[order]
-    first = np.ones(len(keys), dtype=bool)
-    first[1:] = sorted_keys[1:] != sorted_keys[:-1]
-    starts = np.flatnonzero(first)
-    counts = np.diff(np.append(starts, len(keys)))
-    edge_id_sorted = np.cumsum(first) - 1
-    face_edges = np.empty(len(keys), dtype=np.int64)
-    face_edges[order] = edge_id_sorted
-    face_edges = face_edges.reshape(m, 3)
-    edges = np.stack([lo[order[starts]], hi[order[starts]]], axis=1)
-
-    if (counts > 2).any():
-        e = int(np.flatnonzero(counts > 2)[0])
-        raise MeshTopologyError(
-            f"{name}: {int((counts > 2).sum())} non-manifold edges shared by more than two faces "
-            f"(first: edge {edges[e].tolist()}, {int(counts[e])} faces)"
-        )
-    # Each interior edge must be used once in each direction.
-    forward = (a < b)[order]
-    interior = counts == 2
-    fwd_sum = np.add.reduceat(forward.astype(np.int64), starts)
-    bad_winding = interior & (fwd_sum != 1)
-    if bad_winding.any():
-        e = int(np.flatnonzero(bad_winding)[0])
-        raise MeshTopologyError(
-            f"{name}: faces are not consistently wound ({int(bad_winding.sum())} edges are "
-            f"used twice in the same direction, first: edge {edges[e].tolist()}); "
-            f"orient the faces consistently first"
-        )
-
-    face_of = order // 3
-    edge_faces = np.full((len(edges), 2), -1, dtype=np.int64)
-    edge_faces[:, 0] = face_of[starts]
-    edge_faces[interior, 1] = face_of[starts[interior] + 1]
-
+    t = edge_tables(f, n, name=name)
+    edges, face_edges, edge_faces = t.edges, t.face_edges, t.edge_faces
+    interior = edge_faces[:, 1] >= 0
     # Pieces: faces joined through shared edges.
     pairs = edge_faces[interior]
     adjacency = sp.coo_matrix(
@@ -250,17 +313,8 @@ def validate_mesh(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, n
         raise MeshTopologyError(
             f"{name}: the surface is closed (no boundary edge); cut it open along a seam first"
         )
-    # Directed boundary edges, oriented with the surface to their left.
-    bh = order[starts[boundary]]
-    b_from, b_to = a[bh], b[bh]
-    out_degree = np.bincount(b_from, minlength=n)
-    if (out_degree > 1).any():
-        vtx = int(np.flatnonzero(out_degree > 1)[0])
-        raise MeshTopologyError(
-            f"{name}: non-manifold vertex {vtx} (the boundary passes through it "
-            f"{int(out_degree[vtx])} times); split it first"
-        )
-    loops = _trace_loops(b_from, b_to, n)
+    check_boundary_vertices(t, n, name=name)
+    loops = trace_loops(t.boundary_from, t.boundary_to, n)
 
     chi = n - len(edges) + m
     genus2 = 2 - len(loops) - chi
@@ -285,7 +339,7 @@ def validate_mesh(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, n
     return v, f, connectivity
 
 
-def _trace_loops(b_from: np.ndarray, b_to: np.ndarray, n: int) -> list[np.ndarray]:
+def trace_loops(b_from: np.ndarray, b_to: np.ndarray, n: int) -> list[np.ndarray]:
     """Chain directed boundary edges (each vertex starts at most one) into loops."""
     succ = np.full(n, -1, dtype=np.int64)
     succ[b_from] = b_to

@@ -20,7 +20,7 @@ from . import grow
 from .embed import lscm, tutte_embedding
 from .relax import align_to_pins, best_scale, check_pins, relax
 
-__all__ = ["METHODS", "Flattening", "flatten_mesh"]
+__all__ = ["METHODS", "Flattening", "flatten", "flatten_mesh"]
 
 METHODS = ("relaxed", "isometric", "conformal")
 """The flattening methods :func:`flatten_mesh` accepts."""
@@ -235,3 +235,53 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
         iterations=result.iterations,
         converged=result.converged,
     )
+
+
+def flatten(model, *, method: str = "relaxed", max_iterations: int = 500, tolerance: float = 1e-4,
+            progress=None):
+    """Lay every panel of a model flat at true scale.
+
+    Parameters
+    ----------
+    model : patterns.Model
+        From :func:`patterns.load`.
+    method : {"relaxed", "isometric", "conformal"}
+        See :func:`flatten_mesh`.
+    max_iterations, tolerance
+        ``"relaxed"`` only; see :func:`flatten_mesh`.
+    progress : callable, optional
+        ``progress(panels_done, n_panels)`` after each panel.
+
+    Returns
+    -------
+    patterns.Pattern
+        One :class:`~patterns.FlatPanel` per panel (vertex ``i`` of the panel at
+        ``uv[i]``), and each seam with its flat length on either side.
+
+    Raises
+    ------
+    InputError
+        Not a model, or bad options.
+    FlattenError
+        See :func:`flatten_mesh`.
+    """
+    from ..model import Model
+    from ..pattern import FlatPanel, FlatSeam, Pattern
+
+    if not isinstance(model, Model):
+        raise InputError(f"flatten() takes a patterns.Model (from patterns.load), got {type(model).__name__}")
+    flat = []
+    for i, panel in enumerate(model.panels):
+        result = flatten_mesh(panel.vertices, panel.faces, method=method, max_iterations=max_iterations,
+                              tolerance=tolerance, name=f"{model.name}: panel {panel.name}")
+        flat.append(FlatPanel(panel.name, panel, result))
+        if progress is not None:
+            progress(i + 1, len(model.panels))
+    seams = []
+    for seam in model.seams:
+        lengths = tuple(
+            float(np.linalg.norm(np.diff(flat[p].uv[idx], axis=0), axis=1).sum())
+            for p, idx in zip(seam.panels, seam.vertices)
+        )
+        seams.append(FlatSeam(seam, lengths))
+    return Pattern(model=model, panels=tuple(flat), seams=tuple(seams), method=method)

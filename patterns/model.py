@@ -1,0 +1,132 @@
+"""The loaded model: panels (pieces to cut) joined by seams.
+
+:func:`patterns.load` returns a :class:`Model`; :func:`patterns.flatten` turns it
+into a :class:`patterns.Pattern`.  Everything is in millimetres.  All arrays are
+read-only; nothing here changes after it is made.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Model", "Panel", "Seam"]
+
+
+def _readonly(a) -> np.ndarray:
+    a = np.asarray(a)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class Panel:
+    """One piece to be cut: a triangle mesh that is a disk (or a disk with holes).
+
+    Attributes
+    ----------
+    name : str
+        ``"face3"`` for CAD face 3, the group's name for a group of CAD faces,
+        ``"piece0"`` for a piece of a mesh file.
+    vertices : (n, 3) float64, mm
+    faces : (m, 3) int64
+        Counter-clockwise seen from the outside (the CAD face's orientation).
+    loops : tuple of (k,) int64
+        Boundary loops, the panel to their left; the longest (in 3D) first.
+    cad_faces : tuple of int
+        The CAD faces (indices into the shape's faces, in build123d's
+        ``shape.faces()`` order) meshed into this panel; empty for a mesh file.
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    loops: tuple
+    cad_faces: tuple = ()
+
+    def __post_init__(self):
+        object.__setattr__(self, "vertices", _readonly(self.vertices))
+        object.__setattr__(self, "faces", _readonly(self.faces))
+        object.__setattr__(self, "loops", tuple(_readonly(loop) for loop in self.loops))
+
+    @property
+    def area(self) -> float:
+        """Area of the triangles, mm^2."""
+        p = self.vertices[self.faces]
+        return float(0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum())
+
+
+@dataclass(frozen=True, eq=False)
+class Seam:
+    """A line along which two panels (or two sides of one panel) are joined.
+
+    Attributes
+    ----------
+    id : int
+        Index in :attr:`Model.seams`.
+    panels : (int, int)
+        The panels on either side (indices into :attr:`Model.panels`); equal
+        for a seam that closes one panel on itself (the seam line of a
+        cylinder or cone face, or a cut made to open a tube).
+    points : (k, 3) float64, mm
+        The seam's points, in order, shared by both sides.
+    vertices : ((k,) int64, (k,) int64)
+        The same points as vertex indices into each side's panel.
+    length : float, mm
+        The seam's exact length: the CAD edge's curve length for a CAD seam,
+        the polyline's length for a cut.
+    cad_edge : int or None
+        The CAD edge (index into ``shape.edges()``), or None for a cut that
+        `patterns` made to open a closed surface or a tube.
+    """
+
+    id: int
+    panels: tuple
+    points: np.ndarray
+    vertices: tuple
+    length: float
+    cad_edge: int | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "points", _readonly(self.points))
+        object.__setattr__(self, "vertices", tuple(_readonly(v) for v in self.vertices))
+
+    @property
+    def polyline_length(self) -> float:
+        """Length of the polyline through :attr:`points`, mm (below :attr:`length` on a curve)."""
+        return float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
+
+    @property
+    def closes_panel(self) -> bool:
+        """True when both sides belong to the same panel."""
+        return self.panels[0] == self.panels[1]
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """Panels and seams of one part, in millimetres.
+
+    Attributes
+    ----------
+    name : str
+        The file name, or the build123d object's type.
+    panels : tuple of Panel
+    seams : tuple of Seam
+    max_edge : float, mm
+        The target edge length the panels were meshed to (for mesh files, the
+        longest edge found).
+    """
+
+    name: str
+    panels: tuple
+    seams: tuple
+    max_edge: float
+
+    def seams_of(self, panel: int) -> tuple:
+        """The seams with ``panel`` on either side."""
+        return tuple(s for s in self.seams if panel in s.panels)
+
+    def __repr__(self) -> str:
+        return (f"Model({self.name!r}, {len(self.panels)} panels, {len(self.seams)} seams, "
+                f"max_edge={self.max_edge:.4g} mm)")
