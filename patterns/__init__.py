@@ -12,7 +12,7 @@ The public API, all importable from the top level::
     result.overlap.one_to_one, result.distortion.edge_strain_rms
 """
 
-from .check import Overlap, overlap_verdict
+from .check import Finding, Overlap, Report, check, overlap_verdict
 from .errors import (
     CadError,
     ExportError,
@@ -22,6 +22,7 @@ from .errors import (
     PatternsError,
 )
 from .cut import Cut, cut_to_disk
+from .export import heat_map
 from .flatten import METHODS, Flattening, flatten, flatten_mesh
 from .load import load, read_cad, read_mesh
 from .measure import Distortion, distortion
@@ -40,6 +41,7 @@ __all__ = [
     "Distortion",
     "ExportError",
     "FlattenError",
+    "Finding",
     "FlatPanel",
     "FlatSeam",
     "Flattening",
@@ -50,12 +52,15 @@ __all__ = [
     "Panel",
     "Pattern",
     "PatternsError",
+    "Report",
     "Seam",
     "__version__",
+    "check",
     "cut_to_disk",
     "distortion",
     "flatten",
     "flatten_mesh",
+    "heat_map",
     "load",
     "mesh_shape",
     "overlap_verdict",

@@ -13,13 +13,15 @@ says what failed and where.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 import numpy as np
 import shapely
 
 from .measure import folded_faces
 
-__all__ = ["Overlap", "overlap_verdict"]
+__all__ = ["REPORT_SCHEMA", "Code", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
+           "boundary_crossings", "check", "overlap_verdict"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,3 +107,375 @@ def _first_crossing(ring) -> str:
     if "[" in reason:
         return " at " + reason[reason.index("[") :]
     return ""
+
+
+# --------------------------------------------------------------------------- #
+# The report: an auditor that collects findings, never raises on geometry
+# --------------------------------------------------------------------------- #
+
+
+class Severity(str, Enum):
+    """How bad a :class:`Finding` is."""
+
+    ERROR = "error"
+    """The pattern cannot be cut as it is (folds, overlaps)."""
+    LIMIT = "limit"
+    """A limit the user asked for is exceeded (``max_strain``, ``max_seam_mismatch``)."""
+    NOTE = "note"
+    """Worth knowing, not a failure (the relaxation stopped before converging)."""
+
+
+class Code(str, Enum):
+    """What a :class:`Finding` is about (also its JSON ``code``)."""
+
+    FOLDED_TRIANGLES = "folded-triangles"
+    OUTLINE_CROSSES_ITSELF = "outline-crosses-itself"
+    HOLE_CROSSES_OUTLINE = "hole-crosses-outline"
+    HOLE_OUTSIDE_OUTLINE = "hole-outside-outline"
+    INSIDE_OUT = "inside-out"
+    PANELS_OVERLAP = "panels-overlap"
+    STRAIN_ABOVE_LIMIT = "strain-above-limit"
+    SEAM_MISMATCH_ABOVE_LIMIT = "seam-mismatch-above-limit"
+    NOT_CONVERGED = "not-converged"
+
+
+@dataclass(frozen=True, eq=False)
+class Finding:
+    """One thing the check found.
+
+    Attributes
+    ----------
+    code : Code
+    severity : Severity
+    panels : tuple of str
+        The panel (or the two panels) concerned; empty for a seam-only finding.
+    points : (k, 2) float64, mm
+        Where, in the flat pattern as placed (crossing points, centres of folded
+        triangles, a point inside an overlap, the worst triangle's centre).
+    faces : (j,) int64
+        Triangles concerned (folded, or above the strain limit), indices into
+        the panel's faces; empty when not about triangles.
+    seam : int or None
+        The seam concerned.
+    message : str
+        One line, starting with the panel or seam.
+    """
+
+    code: Code
+    severity: Severity
+    panels: tuple
+    points: np.ndarray
+    faces: np.ndarray
+    seam: int | None
+    message: str
+
+    def to_dict(self) -> dict:
+        return {
+            "code": self.code.value,
+            "severity": self.severity.value,
+            "panels": list(self.panels),
+            "seam": self.seam,
+            "points": self.points.tolist(),
+            "faces": self.faces.tolist(),
+            "message": self.message,
+        }
+
+
+@dataclass(frozen=True)
+class PanelReport:
+    """Numbers of one panel (strains dimensionless: 0.01 = 1 %; areas mm^2).
+
+    The triangle strain is the larger-magnitude principal strain of each
+    triangle; its statistics are weighted by 3D triangle area.
+    """
+
+    name: str
+    n_triangles: int
+    area_3d: float
+    area_flat: float
+    strain_rms: float
+    strain_max: float
+    strain_p95: float
+    share_above_limit: float | None
+    """Share of the 3D area whose triangle strain exceeds ``max_strain`` (None without a limit)."""
+    edge_strain_rms: float
+    edge_strain_max: float
+    n_folded: int
+    one_to_one: bool
+    iterations: int
+    converged: bool
+
+
+@dataclass(frozen=True)
+class SeamReport:
+    """Numbers of one seam (lengths in mm)."""
+
+    id: int
+    panels: tuple
+    """Names of the panels on side 0 and side 1 (equal for a seam closing one panel)."""
+    cad_edge: int | None
+    length_3d: float
+    length_flat: tuple
+    """Flat length on side 0 and on side 1."""
+    mismatch: float
+    """``length_flat[0] - length_flat[1]``, mm."""
+    mismatch_percent: float
+    """``mismatch / length_3d * 100``."""
+
+
+REPORT_SCHEMA = "patterns.report/1"
+"""The ``schema`` value of :meth:`Report.to_dict` (see docs/report.md)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Report:
+    """Everything :func:`check` found about a pattern.
+
+    Attributes
+    ----------
+    pattern : str
+        The pattern's (model's) name.
+    panels : tuple of PanelReport
+    seams : tuple of SeamReport
+    findings : tuple of Finding
+        Errors first, then limits, then notes.
+    max_strain, max_seam_mismatch : float or None
+        The limits asked for.
+    """
+
+    pattern: str
+    panels: tuple
+    seams: tuple
+    findings: tuple
+    max_strain: float | None = None
+    max_seam_mismatch: float | None = None
+
+    @property
+    def ok(self) -> bool:
+        """No error and no exceeded limit (notes do not count)."""
+        return not any(f.severity is not Severity.NOTE for f in self.findings)
+
+    @property
+    def errors(self) -> tuple:
+        return tuple(f for f in self.findings if f.severity is Severity.ERROR)
+
+    def to_dict(self) -> dict:
+        """The JSON document (plain Python types), schema :data:`REPORT_SCHEMA`."""
+        from dataclasses import asdict
+
+        return {
+            "schema": REPORT_SCHEMA,
+            "pattern": self.pattern,
+            "ok": self.ok,
+            "units": {"length": "mm", "area": "mm2", "strain": "ratio (0.01 = 1 %)"},
+            "limits": {"max_strain": self.max_strain, "max_seam_mismatch": self.max_seam_mismatch},
+            "panels": [asdict(p) for p in self.panels],
+            "seams": [{**asdict(s), "panels": list(s.panels), "length_flat": list(s.length_flat)}
+                      for s in self.seams],
+            "findings": [f.to_dict() for f in self.findings],
+        }
+
+    def to_json(self, path) -> None:
+        """Write :meth:`to_dict` as JSON (atomically: a failed write leaves no file)."""
+        import json
+
+        from .export._atomic import atomic_output
+
+        text = json.dumps(self.to_dict(), indent=2, sort_keys=False, allow_nan=False)
+        with atomic_output(path, what="report") as tmp:
+            tmp.write_text(text + "\n", encoding="utf-8")
+
+    def __str__(self) -> str:
+        lines = [f"{self.pattern}: {'ok' if self.ok else 'NOT ok'} "
+                 f"({len(self.panels)} panels, {len(self.seams)} seams, {len(self.findings)} findings)"]
+        lines += [f"  {f.severity.value}: {f.message}" for f in self.findings]
+        return "\n".join(lines)
+
+
+def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float | None = None) -> Report:
+    """Check a pattern before cutting: overlaps, strain, seams.
+
+    Never raises on geometry: every problem becomes a :class:`Finding` with
+    the place it is at.
+
+    Parameters
+    ----------
+    pattern : patterns.Pattern
+    max_strain : float, optional
+        Largest acceptable triangle strain (0.03 = 3 %); triangles above it
+        are reported, with the share of area they cover.
+    max_seam_mismatch : float, optional
+        Largest acceptable difference between the two flat lengths of a seam,
+        mm.
+
+    Returns
+    -------
+    Report
+
+    Raises
+    ------
+    InputError
+        Not a pattern, or a limit that is not a positive number.
+    """
+    from .errors import InputError
+    from .measure import edge_strain, triangle_strains, weighted_percentile
+    from .pattern import Pattern
+
+    if not isinstance(pattern, Pattern):
+        raise InputError(f"check() takes a patterns.Pattern (from patterns.flatten), got {type(pattern).__name__}")
+    for label, value in (("max_strain", max_strain), ("max_seam_mismatch", max_seam_mismatch)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or not np.isfinite(value) or value <= 0):
+            raise InputError(f"{pattern.name}: {label} must be a positive number, got {value!r}")
+    findings = []
+    panel_reports = []
+    for flat in pattern.panels:
+        uv, faces, vertices = flat.uv, flat.faces, flat.vertices
+        ts = triangle_strains(vertices, faces, uv)
+        mag, w = ts.magnitude, ts.area_3d
+        es = edge_strain(vertices, faces, uv)
+        share = None
+        if max_strain is not None:
+            above = np.flatnonzero(mag > max_strain)
+            share = float(w[above].sum() / w.sum())
+            if len(above):
+                worst = above[np.argmax(mag[above])]
+                centre = uv[faces[worst]].mean(axis=0)
+                findings.append(Finding(
+                    Code.STRAIN_ABOVE_LIMIT, Severity.LIMIT, (flat.name,), centre[None, :], _ro(above), None,
+                    f"panel {flat.name}: strain above {max_strain:.2%} on {share:.1%} of its area "
+                    f"({len(above)} triangles), up to {mag[worst]:.2%} at ({centre[0]:.1f}, {centre[1]:.1f}) mm"))
+        findings += _panel_overlaps(flat)
+        res = flat.flattening
+        if not res.converged:
+            findings.append(Finding(Code.NOT_CONVERGED, Severity.NOTE, (flat.name,), np.zeros((0, 2)),
+                                    np.zeros(0, dtype=np.int64), None,
+                                    f"panel {flat.name}: the relaxation stopped after {res.iterations} iterations "
+                                    f"before converging"))
+        panel_reports.append(PanelReport(
+            name=flat.name, n_triangles=len(faces), area_3d=float(w.sum()), area_flat=flat.area,
+            strain_rms=float(np.sqrt(np.sum(w * mag**2) / w.sum())), strain_max=float(mag.max()),
+            strain_p95=weighted_percentile(mag, w, 95.0), share_above_limit=share,
+            edge_strain_rms=float(np.sqrt(np.mean(es**2))), edge_strain_max=float(es.max()),
+            n_folded=int(np.count_nonzero(ts.area_change <= -1.0)), one_to_one=bool(res.one_to_one),
+            iterations=int(res.iterations), converged=bool(res.converged)))
+    findings += _overlaps_between(pattern)
+    seam_reports = []
+    for fs in pattern.seams:
+        seam = fs.seam
+        names = tuple(pattern.panels[p].name for p in seam.panels)
+        pct = 100.0 * fs.mismatch / seam.length if seam.length > 0 else 0.0
+        seam_reports.append(SeamReport(seam.id, names, seam.cad_edge, float(seam.length),
+                                       tuple(float(x) for x in fs.flat_lengths), fs.mismatch, pct))
+        if max_seam_mismatch is not None and abs(fs.mismatch) > max_seam_mismatch:
+            mid = pattern.panels[seam.panels[0]].uv[seam.vertices[0][len(seam.vertices[0]) // 2]]
+            findings.append(Finding(
+                Code.SEAM_MISMATCH_ABOVE_LIMIT, Severity.LIMIT, names, mid[None, :], np.zeros(0, dtype=np.int64),
+                seam.id, f"seam {seam.id} ({names[0]} / {names[1]}): flat lengths {fs.flat_lengths[0]:.2f} and "
+                         f"{fs.flat_lengths[1]:.2f} mm differ by {abs(fs.mismatch):.2f} mm "
+                         f"(limit {max_seam_mismatch:g} mm)"))
+    order = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
+    findings.sort(key=lambda f: order[f.severity])
+    return Report(pattern.name, tuple(panel_reports), tuple(seam_reports), tuple(findings), max_strain,
+                  max_seam_mismatch)
+
+
+def _ro(a) -> np.ndarray:
+    a = np.asarray(a)
+    a.setflags(write=False)
+    return a
+
+
+def boundary_crossings(uv: np.ndarray, loops) -> list[tuple[int, int, np.ndarray]]:
+    """Where flat boundary segments cross.
+
+    Parameters
+    ----------
+    uv : (n, 2) float64
+    loops : sequence of (k,) int64
+
+    Returns
+    -------
+    list of (loop_a, loop_b, points (p, 2) float64)
+        One entry per pair of loops that cross (``loop_a == loop_b`` for a loop
+        crossing itself), with the crossing points.  Segments that share a
+        vertex are not counted as crossing there.
+    """
+    starts = np.concatenate(loops)
+    ends = np.concatenate([np.roll(loop, -1) for loop in loops])
+    loop_of = np.concatenate([np.full(len(loop), i) for i, loop in enumerate(loops)])
+    lines = shapely.linestrings(np.stack([uv[starts], uv[ends]], axis=1))
+    i, j = shapely.STRtree(lines).query(lines, predicate="intersects")
+    keep = i < j
+    i, j = i[keep], j[keep]
+    pair = np.stack([starts, ends], axis=1)
+    adjacent = (pair[i][:, :, None] == pair[j][:, None, :]).any(axis=(1, 2))
+    i, j = i[~adjacent], j[~adjacent]
+    out = {}
+    for a, b in zip(i, j):
+        key = (int(min(loop_of[a], loop_of[b])), int(max(loop_of[a], loop_of[b])))
+        geom = shapely.intersection(lines[a], lines[b])
+        pts = shapely.get_coordinates(geom)
+        if len(pts):
+            out.setdefault(key, []).append(pts.mean(axis=0))
+    return [(a, b, np.array(p)) for (a, b), p in sorted(out.items())]
+
+
+def _panel_overlaps(flat) -> list:
+    """Findings for one panel overlapping itself: folds, crossing loops, misplaced holes."""
+    uv, faces, loops, name = flat.uv, flat.faces, flat.loops, flat.name
+    out = []
+    folded = folded_faces(faces, uv)
+    none = np.zeros(0, dtype=np.int64)
+    if len(folded):
+        centres = uv[faces[folded]].mean(axis=1)
+        c = centres[0]
+        out.append(Finding(Code.FOLDED_TRIANGLES, Severity.ERROR, (name,), _ro(centres), _ro(folded), None,
+                           f"panel {name}: {len(folded)} folded triangles (first: face {int(folded[0])} "
+                           f"at ({c[0]:.1f}, {c[1]:.1f}) mm)"))
+    for a, b, pts in boundary_crossings(uv, loops):
+        code = Code.OUTLINE_CROSSES_ITSELF if a == b == 0 else Code.HOLE_CROSSES_OUTLINE
+        what = ("its outline crosses itself" if a == b == 0 else
+                f"hole {b} crosses the outline" if a == 0 else
+                f"hole {a} crosses itself" if a == b else f"holes {a} and {b} cross")
+        out.append(Finding(code, Severity.ERROR, (name,), _ro(pts), none, None,
+                           f"panel {name}: {what} at {len(pts)} points (first: ({pts[0, 0]:.1f}, {pts[0, 1]:.1f}) mm)"))
+    rings = [shapely.linearrings(uv[loop]) for loop in loops]
+    if not shapely.is_ccw(rings[0]):
+        c = uv[loops[0]].mean(axis=0)
+        out.append(Finding(Code.INSIDE_OUT, Severity.ERROR, (name,), c[None, :], none, None,
+                           f"panel {name}: the flat outline runs clockwise (the panel is turned inside out)"))
+    outer = shapely.Polygon(uv[loops[0]])
+    for k in range(1, len(loops)):
+        inside = shapely.contains_xy(outer, uv[loops[k], 0], uv[loops[k], 1])
+        if not inside.any():
+            p = uv[loops[k]][0]
+            out.append(Finding(Code.HOLE_OUTSIDE_OUTLINE, Severity.ERROR, (name,), p[None, :], none, None,
+                               f"panel {name}: hole {k} lies outside the outline, near ({p[0]:.1f}, {p[1]:.1f}) mm"))
+    return out
+
+
+def _overlaps_between(pattern) -> list:
+    """Findings for placed panels that overlap each other."""
+    if len(pattern.panels) < 2 or not pattern.laid_out:
+        return []
+    polys = []
+    for flat in pattern.panels:
+        uv = flat.uv
+        polys.append(shapely.make_valid(shapely.Polygon(uv[flat.loops[0]], [uv[lp] for lp in flat.loops[1:]])))
+    polys = np.array(polys, dtype=object)
+    i, j = shapely.STRtree(polys).query(polys, predicate="intersects")
+    keep = i < j
+    out = []
+    none = np.zeros(0, dtype=np.int64)
+    for a, b in zip(i[keep], j[keep]):
+        common = shapely.intersection(polys[a], polys[b])
+        area = shapely.area(common)
+        scale = min(shapely.area(polys[a]), shapely.area(polys[b]))
+        if area <= 1e-9 * scale:
+            continue  # touching along an edge or at a point
+        p = shapely.get_coordinates(shapely.point_on_surface(common))[0]
+        na, nb = pattern.panels[a].name, pattern.panels[b].name
+        out.append(Finding(Code.PANELS_OVERLAP, Severity.ERROR, (na, nb), _ro(p[None, :]), none, None,
+                           f"panels {na} and {nb} overlap by {area:.1f} mm^2 around ({p[0]:.1f}, {p[1]:.1f}) mm"))
+    return out

@@ -236,8 +236,8 @@ def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max
         edge, radians (> 0).
     max_edge : float, optional
         CAD only: target edge length, mm (> 0); default from the part's area
-        (about 4000 triangles).  Curved faces and edges get shorter ones to meet
-        the tolerances.
+        (about 4000 triangles, and at least about 1000 on every face).  Curved
+        faces and edges get shorter ones to meet the tolerances.
     faces : mapping of str to list of int, optional
         CAD only: groups of CAD faces (indices in ``shape.faces()`` order) to
         cut as one panel each, e.g. ``{"front": [0, 1], "back": [2, 3]}``.

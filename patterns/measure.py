@@ -20,11 +20,14 @@ import numpy as np
 
 __all__ = [
     "Distortion",
+    "TriangleStrain",
     "affine_coefficients",
     "area_ratio",
     "boundary_lengths",
     "distortion",
     "edge_strain",
+    "triangle_strains",
+    "weighted_percentile",
     "folded_faces",
     "local_coordinates",
     "principal_stretches",
@@ -245,3 +248,80 @@ def distortion(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, loops
         boundary_3d=b3,
         boundary_flat=bf,
     )
+
+
+@dataclass(frozen=True, eq=False)
+class TriangleStrain:
+    """Strain of every triangle of a flattening (read-only arrays, dimensionless).
+
+    Attributes
+    ----------
+    stretch : (m, 2) float64
+        Principal stretches ``sigma1 >= sigma2``: flat length over 3D length
+        in the directions of most and least stretch.
+    strain : (m, 2) float64
+        Principal strains ``stretch - 1`` (0.03 = stretched 3 %, -0.03 =
+        compressed 3 %).
+    dominant : (m,) float64
+        The principal strain of larger magnitude, with its sign.
+    direction : (m,) float64
+        Angle in the flat pattern (radians, from +u, in [0, pi)) of the
+        direction of the dominant strain.
+    area_change : (m,) float64
+        ``flat area / 3D area - 1`` (signed area: a folded triangle is below -1).
+    area_3d : (m,) float64
+        3D areas, in the square of the mesh unit (the weights of the statistics).
+    """
+
+    stretch: np.ndarray
+    strain: np.ndarray
+    dominant: np.ndarray
+    direction: np.ndarray
+    area_change: np.ndarray
+    area_3d: np.ndarray
+
+    @property
+    def magnitude(self) -> np.ndarray:
+        """(m,) float64: ``|dominant|``, the largest strain in any direction."""
+        return np.abs(self.dominant)
+
+
+def triangle_strains(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> TriangleStrain:
+    """Principal strains, their directions and the area change of every triangle.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    uv : (n, 2) float64
+        Flat positions, same unit as ``vertices``.
+
+    Returns
+    -------
+    TriangleStrain
+    """
+    alpha, beta = affine_coefficients(vertices, faces, uv)
+    a, b = np.abs(alpha), np.abs(beta)
+    stretch = np.stack([a + b, np.abs(a - b)], axis=1)
+    strain = stretch - 1.0
+    first = np.abs(strain[:, 0]) >= np.abs(strain[:, 1])
+    dominant = np.where(first, strain[:, 0], strain[:, 1])
+    # w = alpha z + beta conj(z) stretches most along the flat direction
+    # (arg alpha + arg beta) / 2, least at right angles to it.
+    angle = 0.5 * (np.angle(alpha) + np.angle(beta)) + np.where(first, 0.0, 0.5 * np.pi)
+    direction = np.mod(angle, np.pi)
+    p = vertices[faces]
+    a3 = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    change = signed_areas(faces, uv) / a3 - 1.0
+    arrays = [stretch, strain, dominant, direction, change, a3]
+    for x in arrays:
+        x.setflags(write=False)
+    return TriangleStrain(*arrays)
+
+
+def weighted_percentile(values: np.ndarray, weights: np.ndarray, q: float) -> float:
+    """The ``q``-th percentile (0-100) of ``values`` under ``weights`` (lower value at a tie)."""
+    order = np.argsort(values, kind="stable")
+    cum = np.cumsum(weights[order])
+    k = int(np.searchsorted(cum, q / 100.0 * cum[-1], side="left"))
+    return float(values[order][min(k, len(values) - 1)])

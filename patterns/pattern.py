@@ -30,11 +30,21 @@ class FlatPanel:
     name: str
     panel: object
     flattening: object
+    placement: tuple = (0.0, 0.0, 0.0)
+    """``(angle, dx, dy)``: the rigid motion (radians, mm) that puts the
+    flattened panel where it lies on the sheet: rotate about the origin, then
+    move.  ``(0, 0, 0)`` until the pattern is laid out."""
 
     @property
     def uv(self) -> np.ndarray:
-        """(n, 2) float64, mm: flat position of each panel vertex."""
-        return self.flattening.uv
+        """(n, 2) float64, mm: flat position of each panel vertex, as placed."""
+        angle, dx, dy = self.placement
+        if angle == 0.0 and dx == 0.0 and dy == 0.0:
+            return self.flattening.uv
+        c, s = np.cos(angle), np.sin(angle)
+        uv = self.flattening.uv @ np.array([[c, s], [-s, c]]) + np.array([dx, dy])
+        uv.setflags(write=False)
+        return uv
 
     @property
     def vertices(self) -> np.ndarray:
@@ -109,6 +119,9 @@ class Pattern:
     panels: tuple
     seams: tuple
     method: str
+    laid_out: bool = False
+    """True once the panels have been placed on a sheet (:meth:`placed`): only
+    then are panels checked against each other."""
 
     @property
     def name(self) -> str:
@@ -118,6 +131,36 @@ class Pattern:
     def one_to_one(self) -> bool:
         """True when no panel overlaps itself."""
         return all(p.flattening.one_to_one for p in self.panels)
+
+    def heat_map(self, path, **options) -> None:
+        """Write the strain heat map (PNG or SVG); see :func:`patterns.heat_map`."""
+        from .export.heatmap import heat_map
+
+        heat_map(self, path, **options)
+
+    def placed(self, placements) -> "Pattern":
+        """A copy with the panels moved rigidly: one ``(angle, dx, dy)`` per panel.
+
+        Rotation (radians) about the origin of the flattened panel, then a
+        translation (mm).  Nothing is scaled; seams' flat lengths are unchanged.
+        """
+        from dataclasses import replace
+
+        from .errors import InputError
+
+        placements = list(placements)
+        if len(placements) != len(self.panels):
+            raise InputError(f"{self.name}: {len(placements)} placements for {len(self.panels)} panels")
+        panels = []
+        for panel, place in zip(self.panels, placements):
+            try:
+                angle, dx, dy = (float(x) for x in place)
+            except (TypeError, ValueError):
+                raise InputError(f"{self.name}: a placement is (angle, dx, dy), got {place!r}") from None
+            if not np.all(np.isfinite([angle, dx, dy])):
+                raise InputError(f"{self.name}: placements must be finite, got {place!r}")
+            panels.append(replace(panel, placement=(angle, dx, dy)))
+        return replace(self, panels=tuple(panels), laid_out=True)
 
     def __repr__(self) -> str:
         return f"Pattern({self.name!r}, {len(self.panels)} panels, {len(self.seams)} seams, method={self.method!r})"

@@ -16,7 +16,7 @@ from .load import drop_unused
 from .cut import cut_to_disk
 from .mesh import face_areas, validate_mesh
 
-__all__ = ["DEFAULT_TRIANGLES", "mesh_shape", "tessellate_face"]
+__all__ = ["DEFAULT_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
 
 
 def tessellate_face(face, *, tolerance: float = 0.05, angular_tolerance: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
@@ -72,7 +72,10 @@ def tessellate_face(face, *, tolerance: float = 0.05, angular_tolerance: float =
 
 DEFAULT_TRIANGLES = 4000
 """With no ``max_edge``, the target edge length gives about this many triangles over
-the whole shape's area (before curvature refines it)."""
+the whole shape's area (before curvature refines it)..."""
+
+MIN_FACE_TRIANGLES = 1000
+"""... and each face at least about this many of its own."""
 
 _GRID = 41  # samples per parameter direction of a face's development table
 
@@ -93,7 +96,8 @@ def mesh_shape(shape, *, max_edge: float | None = None, tolerance: float = 0.05,
     shape : OCP ``TopoDS_Shape`` or build123d shape
     max_edge : float, optional
         Target edge length, mm (> 0).  Default: the length that gives about
-        :data:`DEFAULT_TRIANGLES` triangles over the shape's area.
+        :data:`DEFAULT_TRIANGLES` triangles over the shape's area, shorter on
+        a face that would get fewer than :data:`MIN_FACE_TRIANGLES`.
     tolerance : float
         Largest distance from a triangle or segment to the true surface or
         edge, mm (> 0); curved faces and edges get shorter edges to meet it.
@@ -335,14 +339,18 @@ class _ShapeMesher:
         total = float(sum(areas))
         if not total > 0:
             raise CadError(f"{self.name}: the faces have no area")
-        h = float(max_edge) if max_edge is not None else float(np.sqrt(4 * total / (np.sqrt(3) * DEFAULT_TRIANGLES)))
+        def spacing(area, triangles):
+            return float(np.sqrt(4 * area / (np.sqrt(3) * triangles)))
+
+        h = float(max_edge) if max_edge is not None else spacing(total, DEFAULT_TRIANGLES)
         self.h = h
         face_h = []
-        for dev in self.devs:
+        for dev, area in zip(self.devs, areas):
             kappa = dev.curvature()
-            hf = h
+            # By default a small face still gets MIN_FACE_TRIANGLES of its own.
+            hf = h if max_edge is not None else min(h, spacing(area, MIN_FACE_TRIANGLES))
             if kappa > 0:
-                hf = min(h, np.sqrt(8 * tolerance / kappa), angular_tolerance / kappa)
+                hf = min(hf, np.sqrt(8 * tolerance / kappa), angular_tolerance / kappa)
             face_h.append(max(hf, h / 50))
         self.face_h = face_h
         edge_faces = [[] for _ in self.edges.items]

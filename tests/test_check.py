@@ -1,0 +1,226 @@
+"""patterns.check: the report's numbers against independent computations, overlaps
+caught with their place, the JSON report, the heat map."""
+
+import json
+
+import numpy as np
+import pytest
+
+import patterns
+from patterns import surfaces
+from patterns.check import Code, Severity
+from patterns.errors import ExportError, InputError
+
+from .conftest import SAMPLES
+
+
+@pytest.fixture(scope="module")
+def hopper():
+    return patterns.flatten(patterns.load(SAMPLES / "hopper.step"))
+
+
+@pytest.fixture(scope="module")
+def cup():
+    return patterns.flatten(patterns.load(SAMPLES / "cup.step"))
+
+
+def independent_triangle_strain(vertices, faces, uv):
+    """Dominant principal strain per triangle by an SVD of the 3D -> 2D Jacobian
+    (orthonormal frame from the first edge and the normal), and the 3D areas."""
+    p, q = vertices[faces], uv[faces]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    x = e1 / np.linalg.norm(e1, axis=1, keepdims=True)
+    n = np.cross(e1, e2)
+    area = 0.5 * np.linalg.norm(n, axis=1)
+    y = np.cross(n / np.linalg.norm(n, axis=1, keepdims=True), x)
+    ref = np.stack([np.stack([(e1 * x).sum(1), (e2 * x).sum(1)], -1),
+                    np.stack([(e1 * y).sum(1), (e2 * y).sum(1)], -1)], -2)  # columns: edges in 2D frame
+    flat = np.stack([q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]], -1)  # (m, 2, 2) columns
+    jac = flat @ np.linalg.inv(ref)
+    s = np.linalg.svd(jac, compute_uv=False)  # (m, 2) descending
+    strain = s - 1
+    dominant = np.where(np.abs(strain[:, 0]) >= np.abs(strain[:, 1]), strain[:, 0], strain[:, 1])
+    return dominant, area
+
+
+def test_developable_sample_has_no_strain_and_no_mismatch(hopper):
+    report = patterns.check(hopper)
+    assert report.ok and report.findings == ()
+    (panel,) = report.panels
+    assert panel.strain_max < 1e-3 and panel.strain_rms < 1e-4
+    assert panel.area_flat == pytest.approx(panel.area_3d, rel=1e-6)
+    (seam,) = report.seams
+    assert seam.panels == ("face0", "face0") and seam.cad_edge is not None
+    assert abs(seam.mismatch) < 1e-3 and abs(seam.mismatch_percent) < 1e-4  # measured 1.1e-4 mm on 447 mm
+    assert seam.length_flat[0] == pytest.approx(seam.length_3d, rel=1e-4)
+
+
+def test_doubly_curved_strain_statistics_equal_an_independent_computation(cup):
+    report = patterns.check(cup, max_strain=0.03)
+    for flat, numbers in zip(cup.panels, report.panels):
+        dominant, area = independent_triangle_strain(flat.vertices, flat.faces, flat.uv)
+        mag = np.abs(dominant)
+        assert numbers.strain_max == pytest.approx(mag.max(), rel=1e-9)
+        assert numbers.strain_rms == pytest.approx(np.sqrt(np.sum(area * mag**2) / area.sum()), rel=1e-9)
+        order = np.argsort(mag)
+        cum = np.cumsum(area[order]) / area.sum()
+        assert numbers.strain_p95 == pytest.approx(mag[order][np.searchsorted(cum, 0.95)], rel=1e-9)
+        assert numbers.share_above_limit == pytest.approx(area[mag > 0.03].sum() / area.sum(), rel=1e-9)
+        assert numbers.area_3d == pytest.approx(area.sum(), rel=1e-12)
+        # Measured on the quarter-sphere panels: RMS 3.2 %, max 8.3 %, 35 % of the area above 3 %.
+        assert 0.015 < numbers.strain_rms < 0.035 and 0.1 < numbers.share_above_limit < 0.4
+    # The strain limit is a finding with the worst place named, and the report is not ok.
+    limits = [f for f in report.findings if f.code is Code.STRAIN_ABOVE_LIMIT]
+    assert len(limits) == 4 and not report.ok
+    for f, flat in zip(limits, cup.panels):
+        dominant, _ = independent_triangle_strain(flat.vertices, flat.faces, flat.uv)
+        worst = np.argmax(np.abs(dominant))
+        np.testing.assert_allclose(f.points[0], flat.uv[flat.faces[worst]].mean(axis=0), atol=1e-9)
+        assert set(f.faces.tolist()) == set(np.flatnonzero(np.abs(dominant) > 0.03).tolist())
+    # Mating seams: flat lengths on both sides, mismatch in mm and %.
+    for seam, fs in zip(report.seams, cup.seams):
+        assert seam.length_flat == pytest.approx(fs.flat_lengths)
+        assert seam.mismatch == pytest.approx(fs.flat_lengths[0] - fs.flat_lengths[1])
+        assert seam.mismatch_percent == pytest.approx(100 * seam.mismatch / seam.length_3d)
+
+
+def test_strain_direction_points_along_the_stretch():
+    # A flat square stretched 10 % along a direction at 30 degrees in the plane.
+    p, f = surfaces.disk_mesh(200)
+    v = np.column_stack([p * 50, np.zeros(len(p))])
+    t = np.radians(30)
+    d = np.array([np.cos(t), np.sin(t)])
+    uv = p * 50 + 0.1 * np.outer(p * 50 @ d, d)
+    ts = patterns.measure.triangle_strains(v, f, uv)
+    np.testing.assert_allclose(ts.dominant, 0.1, atol=1e-12)
+    np.testing.assert_allclose(ts.direction, t, atol=1e-9)
+    np.testing.assert_allclose(ts.area_change, 0.1, atol=1e-12)
+
+
+def test_overlapping_layout_is_caught_with_the_place_named(cup):
+    a = cup.panels[0]
+    width = np.ptp(a.uv[:, 0])
+    # Panel 1 is put 40 % of a width to the right of panel 0: they overlap.
+    apart = [(0.0, 3 * width * k, 0.0) for k in range(4)]
+    assert patterns.check(cup.placed(apart)).ok
+    shifted = list(apart)
+    shifted[1] = (0.0, 0.4 * width, 0.0)
+    report = patterns.check(cup.placed(shifted))
+    (finding,) = [f for f in report.findings if f.code is Code.PANELS_OVERLAP]
+    assert finding.severity is Severity.ERROR and finding.panels == ("face0", "face1") and not report.ok
+    import shapely
+
+    placed = cup.placed(shifted)
+    p0 = shapely.Polygon(placed.panels[0].uv[placed.panels[0].loops[0]])
+    p1 = shapely.Polygon(placed.panels[1].uv[placed.panels[1].loops[0]])
+    common = p0.intersection(p1)
+    assert common.area > 0
+    assert shapely.contains_xy(common.buffer(1e-6), *finding.points[0])
+    assert f"{common.area:.1f} mm^2" in finding.message
+
+
+def test_folded_flattening_is_caught_with_the_triangles_named(cup):
+    flat = cup.panels[0]
+    uv = np.array(flat.uv)
+    # Push one interior vertex across its neighbours: its fan folds.
+    boundary = np.zeros(len(uv), dtype=bool)
+    boundary[np.concatenate(flat.loops)] = True
+    vtx = int(np.flatnonzero(~boundary)[len(uv) // 3])
+    fan = np.flatnonzero((flat.faces == vtx).any(axis=1))
+    uv[vtx] += 3 * np.ptp(uv[flat.faces[fan]].reshape(-1, 2), axis=0)
+    broken = patterns.flatten_mesh(flat.vertices, flat.faces, method="isometric")
+    from dataclasses import replace
+
+    folded_result = replace(broken, uv=uv, overlap=patterns.overlap_verdict(flat.faces, uv, flat.loops))
+    bad = replace(cup, panels=(replace(flat, flattening=folded_result),) + cup.panels[1:])
+    report = patterns.check(bad)
+    (finding,) = [f for f in report.findings if f.code is Code.FOLDED_TRIANGLES]
+    expected = np.flatnonzero(patterns.measure.signed_areas(flat.faces, uv) <= 0)
+    assert len(expected) > 0 and set(finding.faces.tolist()) == set(expected.tolist())
+    assert set(finding.faces.tolist()) <= set(fan.tolist())
+    np.testing.assert_allclose(finding.points, uv[flat.faces[expected]].mean(axis=1))
+    assert finding.panels == ("face0",) and not report.ok
+    assert report.panels[0].n_folded == len(expected) and not report.panels[0].one_to_one
+
+
+def test_crossing_outline_is_caught_at_the_crossing():
+    # A flat strip whose flattening is bent round so far that its ends cross.
+    st, f = surfaces.grid_mesh(60, 4)
+    s_, t_ = st[:, 0] * 600.0, st[:, 1] * 20.0
+    v = np.column_stack([s_, t_, np.zeros(len(st))])
+    r = patterns.flatten_mesh(v, f, method="isometric")
+    angle = s_ / 600.0 * 2.4 * np.pi
+    radius = 100.0 + t_
+    uv = np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
+    from patterns.check import boundary_crossings
+
+    crossings = boundary_crossings(uv, r.loops)
+    assert crossings and crossings[0][0] == crossings[0][1] == 0
+    pts = crossings[0][2]
+    # Every reported point lies on the flat outline, at a true crossing.
+    import shapely
+
+    ring = shapely.LineString(uv[np.r_[r.loops[0], r.loops[0][:1]]])
+    assert np.all(shapely.distance(shapely.points(pts), ring) < 1e-9)
+
+
+def test_seam_mismatch_limit(cup):
+    report = patterns.check(cup, max_seam_mismatch=0.05)
+    worst = max(abs(s.mismatch) for s in report.seams)
+    found = [f for f in report.findings if f.code is Code.SEAM_MISMATCH_ABOVE_LIMIT]
+    assert len(found) == sum(abs(s.mismatch) > 0.05 for s in report.seams) >= 1
+    assert worst > 0.05
+    assert patterns.check(cup, max_seam_mismatch=10.0).ok
+
+
+def test_json_report_round_trips_with_its_schema(cup, tmp_path):
+    report = patterns.check(cup, max_strain=0.03)
+    path = tmp_path / "cup.json"
+    report.to_json(path)
+    doc = json.loads(path.read_text())
+    assert doc["schema"] == "patterns.report/1" and doc["ok"] is False and doc["pattern"] == "cup.step"
+    assert doc["limits"] == {"max_strain": 0.03, "max_seam_mismatch": None}
+    assert [p["name"] for p in doc["panels"]] == ["face0", "face1", "face2", "face3"]
+    for p, numbers in zip(doc["panels"], report.panels):
+        assert p["strain_rms"] == numbers.strain_rms and p["area_3d"] == numbers.area_3d
+    for s, numbers in zip(doc["seams"], report.seams):
+        assert s["length_flat"] == list(numbers.length_flat) and s["mismatch"] == numbers.mismatch
+    assert {f["code"] for f in doc["findings"]} == {"strain-above-limit"}
+    assert all(len(f["points"][0]) == 2 for f in doc["findings"])
+    with pytest.raises(ExportError):
+        report.to_json(tmp_path / "missing" / "r.json")
+    assert not (tmp_path / "missing").exists()
+
+
+@pytest.mark.parametrize("suffix", [".png", ".svg"])
+def test_heat_map_is_written(cup, tmp_path, suffix):
+    path = tmp_path / f"cup{suffix}"
+    cup.heat_map(path, max_strain=0.05)
+    data = path.read_bytes()
+    if suffix == ".png":
+        assert data[:8] == b"\x89PNG\r\n\x1a\n"
+        import matplotlib.image
+
+        img = matplotlib.image.imread(path)
+        assert img.shape[0] > 500 and img.shape[1] > 800
+        # Both ends of the diverging scale are used: red (stretched) and blue (compressed) pixels.
+        rgb = img[..., :3]
+        assert np.any((rgb[..., 0] > 0.6) & (rgb[..., 2] < 0.4)) and np.any((rgb[..., 2] > 0.6) & (rgb[..., 0] < 0.4))
+    else:
+        text = data.decode()
+        assert text.lstrip().startswith("<?xml") and "<svg" in text
+        for name in ("face0", "face1", "face2", "face3", "s0"):
+            assert name in text
+    leftovers = [p for p in tmp_path.iterdir() if p.name.endswith(".part")]
+    assert leftovers == []
+
+
+def test_bad_check_input(cup, tmp_path):
+    with pytest.raises(InputError, match="max_strain"):
+        patterns.check(cup, max_strain=-1)
+    with pytest.raises(InputError, match="takes a patterns.Pattern"):
+        patterns.check("cup")
+    with pytest.raises(InputError, match="heat maps are written as"):
+        cup.heat_map(tmp_path / "x.jpg")
+    with pytest.raises(InputError, match="placements"):
+        cup.placed([(0, 0, 0)])
