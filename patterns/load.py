@@ -220,7 +220,7 @@ def read_cad(path):
 
 
 def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max_edge: float | None = None,
-         faces=None, weld_vertices: bool | None = None):
+         faces=None, sew: bool = True, weld_vertices: bool | None = None):
     """Load a part as panels joined by seams.
 
     Parameters
@@ -241,6 +241,10 @@ def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max
     faces : mapping of str to list of int, optional
         CAD only: groups of CAD faces (indices in ``shape.faces()`` order) to
         cut as one panel each, e.g. ``{"front": [0, 1], "back": [2, 3]}``.
+    sew : bool
+        CAD only: sew faces that meet along an edge without sharing it (a file
+        of loose faces), so that the edge becomes a seam; see
+        :func:`patterns.tessellate.mesh_shape`.
     weld_vertices : bool, optional
         Mesh files only: see :func:`read_mesh`.
 
@@ -266,7 +270,7 @@ def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max
             if weld_vertices is not None:
                 raise InputError(f"{path}: weld_vertices applies to mesh files only")
             return mesh_shape(read_cad(path), max_edge=max_edge, tolerance=tolerance,
-                              angular_tolerance=angular_tolerance, faces=faces, name=path.name)
+                              angular_tolerance=angular_tolerance, faces=faces, sew=sew, name=path.name)
         if suffix in MESH_SUFFIXES:
             if faces is not None:
                 raise InputError(f"{path}: faces (groups of CAD faces) apply to CAD files only")
@@ -278,7 +282,7 @@ def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max
                          f"({', '.join(CAD_SUFFIXES)}) or a mesh file ({', '.join(MESH_SUFFIXES)})")
     if hasattr(source, "wrapped"):
         return mesh_shape(source, max_edge=max_edge, tolerance=tolerance, angular_tolerance=angular_tolerance,
-                          faces=faces, name=type(source).__name__)
+                          faces=faces, sew=sew, name=type(source).__name__)
     raise InputError(f"cannot load a {type(source).__name__}: give a file path or a build123d shape")
 
 

@@ -81,7 +81,7 @@ _GRID = 41  # samples per parameter direction of a face's development table
 
 
 def mesh_shape(shape, *, max_edge: float | None = None, tolerance: float = 0.05,
-               angular_tolerance: float = 0.2, faces=None, name: str = "shape"):
+               angular_tolerance: float = 0.2, faces=None, sew: bool = True, name: str = "shape"):
     """Mesh a CAD shape into panels joined by seams, with well-shaped triangles.
 
     Every CAD edge is divided once, at equal arc length, and both faces along
@@ -108,6 +108,11 @@ def mesh_shape(shape, *, max_edge: float | None = None, tolerance: float = 0.05,
         Groups of CAD faces (indices into ``shape.faces()``) to cut as one
         panel each, e.g. ``{"front": [0, 1]}``; the other faces are panels of
         their own, named ``"face<i>"``.
+    sew : bool
+        Faces that meet along an edge without sharing it (a STEP or IGES of
+        loose faces) are sewn first (OpenCascade ``BRepBuilderAPI_Sewing``,
+        tolerance ``tolerance``), so that their common edges become seams.
+        Already sewn shapes are left as they are.
     name : str
         For error messages and the model's name.
 
@@ -133,10 +138,69 @@ def mesh_shape(shape, *, max_edge: float | None = None, tolerance: float = 0.05,
     if max_edge is not None and (isinstance(max_edge, bool) or not isinstance(max_edge, (int, float))
                                  or not np.isfinite(max_edge) or max_edge <= 0):
         raise InputError(f"{name}: max_edge must be a positive number of mm, got {max_edge!r}")
+    if sew:
+        wrapped = _sewn(wrapped, tolerance)
     mesher = _ShapeMesher(wrapped, name=name)
     groups = mesher.groups(faces)
     return mesher.run(groups, max_edge=max_edge, tolerance=float(tolerance),
                       angular_tolerance=float(angular_tolerance))
+
+
+def _sewn(shape, tolerance: float):
+    """The shape with loose faces sewn along common edges, or the shape itself.
+
+    Sewing is tried only when some edge bounds a single face while another
+    edge of the same length and ends does too, i.e. two faces meet there
+    without sharing the edge; the face count must survive the sewing.
+    """
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp, TopExp_Explorer
+    from OCP.BRep import BRep_Tool
+    from OCP.TopoDS import TopoDS
+
+    faces = _Registry()
+    ex = TopExp_Explorer(shape, TopAbs_FACE)
+    while ex.More():
+        faces.index(ex.Current())
+        ex.Next()
+    if len(faces.items) < 2:
+        return shape
+    edges = _Registry()
+    owners = []
+    for k, face in enumerate(faces.items):
+        ee = TopExp_Explorer(face, TopAbs_EDGE)
+        while ee.More():
+            i = edges.index(ee.Current())
+            if i == len(owners):
+                owners.append(set())
+            owners[i].add(k)
+            ee.Next()
+    free = []
+    for edge, own in zip(edges.items, owners):
+        edge = TopoDS.Edge(edge)
+        if len(own) != 1 or BRep_Tool.Degenerated_s(edge):
+            continue
+        a = BRep_Tool.Pnt_s(TopExp.FirstVertex_s(edge))
+        b = BRep_Tool.Pnt_s(TopExp.LastVertex_s(edge))
+        free.append(tuple(sorted([(a.X(), a.Y(), a.Z()), (b.X(), b.Y(), b.Z())])))
+    if len(free) < 2:
+        return shape
+    ends = np.array([np.r_[p, q] for p, q in free])
+    close = np.linalg.norm(ends[:, None, :] - ends[None, :, :], axis=2) <= 2 * tolerance
+    np.fill_diagonal(close, False)
+    if not close.any():
+        return shape
+    sewing = BRepBuilderAPI_Sewing(tolerance)
+    sewing.Add(shape)
+    sewing.Perform()
+    sewn = sewing.SewedShape()
+    count = 0
+    ex = TopExp_Explorer(sewn, TopAbs_FACE)
+    while ex.More():
+        count += 1
+        ex.Next()
+    return sewn if count == len(faces.items) else shape
 
 
 class _Registry:
@@ -492,7 +556,7 @@ class _ShapeMesher:
                 xy = dev.forward(uv)
                 for g, p, q in zip(gids, xy, pos):
                     if ring and slot_gid[ring[-1]] == g and np.allclose(slot_uv[ring[-1]], p,
-                                                                          atol=1e-9 * (1 + h)):
+                                                                          atol=0.01 * h):
                         occ_slots[occ][q] = ring[-1]
                         continue
                     slot_gid.append(int(g))
@@ -500,7 +564,7 @@ class _ShapeMesher:
                     ring.append(len(slot_gid) - 1)
                     occ_slots[occ][q] = ring[-1]
             if len(ring) > 1 and slot_gid[ring[0]] == slot_gid[ring[-1]] and \
-                    np.allclose(slot_uv[ring[0]], slot_uv[ring[-1]], atol=1e-9 * (1 + h)):
+                    np.allclose(slot_uv[ring[0]], slot_uv[ring[-1]], atol=0.01 * h):
                 last = ring.pop()
                 for o in occ_slots:
                     o[o == last] = ring[0]

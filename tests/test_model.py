@@ -284,3 +284,34 @@ def test_model_and_pattern_are_read_only():
     pattern = patterns.flatten(model)
     with pytest.raises(ValueError):
         pattern.panels[0].uv[0, 0] = 1.0
+
+
+def test_iges_and_brep_files_load_like_the_step(tmp_path):
+    from OCP.IGESControl import IGESControl_Writer
+
+    shape = bd.import_step(SAMPLES / "cup.step")
+    writer = IGESControl_Writer("MM", 1)  # 1: B-rep mode, faces share their edges
+    writer.AddShape(shape.wrapped)
+    writer.ComputeModel()
+    assert writer.Write(str(tmp_path / "cup.igs"))
+    bd.export_brep(shape, tmp_path / "cup.brep")
+    for name in ("cup.igs", "cup.brep"):
+        model = patterns.load(tmp_path / name)
+        assert len(model.panels) == 4 and len(model.seams) == 4
+        np.testing.assert_allclose([s.length for s in model.seams], pi / 2 * 90, rtol=1e-6)
+        assert patterns.flatten(model).one_to_one
+
+
+def test_loose_faces_are_sewn_into_seams():
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+
+    shape = bd.import_step(SAMPLES / "cup.step")
+    loose = bd.Compound([bd.Face(BRepBuilderAPI_Copy(f.wrapped).Shape()) for f in shape.faces()])
+    assert len(loose.edges()) == 12  # every face keeps its own three edges
+    assert len(patterns.load(loose, sew=False).seams) == 0
+    model = patterns.load(loose)
+    assert len(model.seams) == 4
+    np.testing.assert_allclose([s.length for s in model.seams], pi / 2 * 90, rtol=1e-6)
+    for seam in model.seams:
+        for side in (0, 1):
+            np.testing.assert_array_equal(model.panels[seam.panels[side]].vertices[seam.vertices[side]], seam.points)
