@@ -22,7 +22,7 @@ from .errors import (
     PatternsError,
 )
 from .cut import Cut, cut_to_disk
-from .export import heat_map
+from .export import heat_map, preview_dxf
 from .flatten import METHODS, Flattening, flatten, flatten_mesh
 from .load import load, read_cad, read_mesh
 from .measure import Distortion, distortion
@@ -64,6 +64,7 @@ __all__ = [
     "load",
     "mesh_shape",
     "overlap_verdict",
+    "preview_dxf",
     "read_cad",
     "read_mesh",
     "tessellate_face",

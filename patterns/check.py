@@ -318,7 +318,7 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
         Not a pattern, or a limit that is not a positive number.
     """
     from .errors import InputError
-    from .measure import edge_strain, triangle_strains, weighted_percentile
+    from .measure import edge_strain, strain_summary, triangle_strains
     from .pattern import Pattern
 
     if not isinstance(pattern, Pattern):
@@ -352,10 +352,10 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
                                     np.zeros(0, dtype=np.int64), None,
                                     f"panel {flat.name}: the relaxation stopped after {res.iterations} iterations "
                                     f"before converging"))
+        rms, biggest, p95 = strain_summary(ts)
         panel_reports.append(PanelReport(
             name=flat.name, n_triangles=len(faces), area_3d=float(w.sum()), area_flat=flat.area,
-            strain_rms=float(np.sqrt(np.sum(w * mag**2) / w.sum())), strain_max=float(mag.max()),
-            strain_p95=weighted_percentile(mag, w, 95.0), share_above_limit=share,
+            strain_rms=rms, strain_max=biggest, strain_p95=p95, share_above_limit=share,
             edge_strain_rms=float(np.sqrt(np.mean(es**2))), edge_strain_max=float(es.max()),
             n_folded=int(np.count_nonzero(ts.area_change <= -1.0)), one_to_one=bool(res.one_to_one),
             iterations=int(res.iterations), converged=bool(res.converged)))

@@ -26,6 +26,7 @@ __all__ = [
     "boundary_lengths",
     "distortion",
     "edge_strain",
+    "strain_summary",
     "triangle_strains",
     "weighted_percentile",
     "folded_faces",
@@ -325,3 +326,13 @@ def weighted_percentile(values: np.ndarray, weights: np.ndarray, q: float) -> fl
     cum = np.cumsum(weights[order])
     k = int(np.searchsorted(cum, q / 100.0 * cum[-1], side="left"))
     return float(values[order][min(k, len(values) - 1)])
+
+
+def strain_summary(strains: TriangleStrain) -> tuple[float, float, float]:
+    """``(rms, max, p95)`` of the triangles' dominant strain magnitude, weighted by 3D area.
+
+    The numbers :func:`patterns.check` reports per panel and the DXF writer
+    prints on it.
+    """
+    mag, w = strains.magnitude, strains.area_3d
+    return (float(np.sqrt(np.sum(w * mag**2) / w.sum())), float(mag.max()), weighted_percentile(mag, w, 95.0))

@@ -132,6 +132,41 @@ class Pattern:
         """True when no panel overlaps itself."""
         return all(p.flattening.one_to_one for p in self.panels)
 
+    def to_dxf(self, path, *, profile: str = "machine", seam_allowance=0.0, units: str = "mm",
+               version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
+               gap: float | None = None) -> None:
+        """Write the pattern as a DXF file for a cutter (atomically).
+
+        Parameters
+        ----------
+        path : str or Path
+        profile : {"machine", "astm"}
+            ``"machine"`` (laser, plasma, waterjet, knife plotter): layers CUT,
+            SEW, NOTCH, GRAIN, BEND, LABEL (and STRAIN); every cut contour one
+            closed polyline.  ``"astm"`` (garment CAD: Gerber, Lectra, Optitex,
+            CLO, Valentina): ASTM D6673 R12, one block per piece.  See docs/dxf.md.
+        seam_allowance : float or mapping
+            Added outside the seam line, mm: one number for every edge, or
+            ``{seam id: mm, ..., None: mm for every other edge}``.  The cut line
+            is then the offset outline (mitred corners) and the seam line goes
+            on SEW (ASTM layer 14).
+        units : {"mm", "cm", "m", "in"}
+            Machine profile only (ASTM is mm).
+        version : str, optional
+            Machine profile: ``"R12"``, ``"R2000"`` (default), ``"R2004"``, ...
+        strain_layer : bool
+            Machine profile: add the strain heat map as filled triangles on
+            layer STRAIN (true colour from R2004).
+        text_height : float, optional
+            mm; default 3 % of each panel's size, 2-12 mm.
+        gap : float, optional
+            Space between panels when the pattern is not laid out, mm.
+        """
+        from .export.dxf import write_pattern_dxf
+
+        write_pattern_dxf(self, path, profile=profile, seam_allowance=seam_allowance, units=units, version=version,
+                          strain_layer=strain_layer, text_height=text_height, gap=gap)
+
     def heat_map(self, path, **options) -> None:
         """Write the strain heat map (PNG or SVG); see :func:`patterns.heat_map`."""
         from .export.heatmap import heat_map

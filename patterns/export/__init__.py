@@ -3,6 +3,8 @@
 from ._atomic import atomic_output
 from .dxf import write_outline_dxf
 from .heatmap import heat_map
+from .dxf import write_pattern_dxf
 from .mesh import write_flat_obj
+from .preview import preview_dxf
 
-__all__ = ["atomic_output", "heat_map", "write_flat_obj", "write_outline_dxf"]
+__all__ = ["atomic_output", "heat_map", "preview_dxf", "write_flat_obj", "write_outline_dxf", "write_pattern_dxf"]

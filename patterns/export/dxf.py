@@ -14,7 +14,8 @@ import numpy as np
 from ..errors import InputError
 from ._atomic import atomic_output
 
-__all__ = ["UNITS", "write_outline_dxf"]
+__all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "PROFILES", "UNITS", "seam_label",
+           "write_outline_dxf", "write_pattern_dxf"]
 
 UNITS = {"mm": 4, "cm": 5, "m": 6, "in": 1}
 """Unit names accepted by the writers and their DXF ``$INSUNITS`` codes."""
@@ -58,3 +59,429 @@ def write_outline_dxf(path, loops: Sequence[np.ndarray], *, units: str = "mm", l
         msp.add_lwpolyline(np.asarray(loop, dtype=np.float64).tolist(), close=True, dxfattribs={"layer": layer})
     with atomic_output(path, what="DXF file") as tmp:
         doc.saveas(tmp)
+
+
+# --------------------------------------------------------------------------- #
+# Whole patterns: machine and ASTM D6673 profiles
+# --------------------------------------------------------------------------- #
+
+PROFILES = ("machine", "astm")
+"""DXF dialects :func:`write_pattern_dxf` writes."""
+
+MACHINE_LAYERS = {
+    "CUT": 1,  # red: every cut contour, one closed polyline each
+    "SEW": 5,  # blue: the seam line, when a seam allowance is added
+    "NOTCH": 6,  # magenta: notch marks at seam ends
+    "GRAIN": 3,  # green: grain line
+    "BEND": 2,  # yellow: bend and ruling lines (sheet metal)
+    "LABEL": 7,  # white/black: every text
+    "STRAIN": 8,  # grey: optional strain heat map (filled triangles)
+}
+"""Layers of the machine profile and their colours (AutoCAD colour index)."""
+
+ASTM_LAYERS = {1: "cut line, piece text", 2: "turn points", 3: "curve points", 4: "notches", 7: "grain line",
+               8: "internal lines", 11: "internal cut-outs", 14: "sew line", 15: "annotation"}
+"""Layers of the ASTM D6673 profile."""
+
+MACHINE_VERSIONS = {"R12": "AC1009", "R2000": "AC1015", "R2004": "AC1018", "R2007": "AC1021",
+                    "R2010": "AC1024", "R2013": "AC1027", "R2018": "AC1032"}
+"""DXF versions the machine profile can write (R2000 by default)."""
+
+
+class _PanelGeometry:
+    """Flat geometry of one panel as it goes into the file (mm, placed)."""
+
+    def __init__(self, pattern, index, offset, allowances, text_height):
+        import shapely
+
+        flat = pattern.panels[index]
+        self.name = flat.name
+        self.index = index
+        uv = np.asarray(flat.uv) + offset
+        self.uv = uv
+        self.seam_loops = [uv[loop] for loop in flat.loops]
+        seam_of = _segment_seams(pattern, index)
+        per_segment = []
+        for loop in flat.loops:
+            ids = [seam_of.get((int(a), int(b)), seam_of.get((int(b), int(a)))) for a, b in
+                   zip(loop, np.roll(loop, -1))]
+            per_segment.append(np.array([allowances(i) for i in ids]))
+        self.allowance = per_segment
+        self.has_allowance = any(np.any(a > 0) for a in per_segment)
+        polygon = shapely.Polygon(self.seam_loops[0], self.seam_loops[1:])
+        self.polygon = polygon
+        if self.has_allowance:
+            cut = _allowance_outline(polygon, self.seam_loops, per_segment)
+            self.cut_loops = [np.asarray(cut.exterior.coords)[:-1]] + [np.asarray(r.coords)[:-1] for r in cut.interiors]
+        else:
+            self.cut_loops = self.seam_loops
+        self.cut_loops = [_snap(loop) for loop in self.cut_loops]
+        inside = shapely.get_coordinates(shapely.point_on_surface(polygon))[0]
+        self.label_at = inside
+        box = np.ptp(self.seam_loops[0], axis=0)
+        self.text_height = text_height if text_height else float(np.clip(0.03 * box.max(), 2.0, 12.0))
+        from ..measure import strain_summary, triangle_strains
+
+        # The same numbers as patterns.check's report.
+        self.strain_rms, self.strain_max, _ = strain_summary(triangle_strains(flat.vertices, flat.faces, flat.uv))
+        self.box = np.r_[uv.min(axis=0), uv.max(axis=0)]
+
+
+def _segment_seams(pattern, index) -> dict:
+    """``(vertex a, vertex b) -> seam id`` for the boundary segments of panel ``index`` on a seam."""
+    out = {}
+    for fs in pattern.seams:
+        seam = fs.seam
+        for p, idx in zip(seam.panels, seam.vertices):
+            if p == index:
+                for a, b in zip(idx[:-1], idx[1:]):
+                    out[(int(a), int(b))] = seam.id
+    return out
+
+
+def _allowance_outline(polygon, loops, per_segment):
+    """The cut outline: the seam line offset outwards by each segment's allowance (mitred corners)."""
+    import shapely
+
+    values = np.concatenate(per_segment)
+    base = float(values.min())
+    cut = polygon.buffer(base, join_style="mitre", mitre_limit=4.0) if base > 0 else polygon
+    parts = [cut]
+    for loop, allow in zip(loops, per_segment):
+        if np.all(allow == base):
+            continue
+        # Runs of segments with the same larger allowance, buffered on their
+        # outer (right-hand) side: the material lies to the left of every loop.
+        n = len(loop)
+        change = np.flatnonzero(allow != np.roll(allow, 1))
+        starts = change if len(change) else np.array([0])
+        for k, s in enumerate(starts):
+            e = starts[(k + 1) % len(starts)] if len(starts) > 1 else s + n
+            if e <= s:
+                e += n
+            a = float(allow[s % n])
+            if a <= base:
+                continue
+            idx = np.arange(s, e + 1) % n
+            line = shapely.LineString(loop[idx])
+            parts.append(shapely.buffer(line, -a, single_sided=True, join_style="mitre", cap_style="flat",
+                                        mitre_limit=4.0))
+    out = shapely.union_all(parts)
+    if out.geom_type != "Polygon":
+        out = max(getattr(out, "geoms", [out]), key=lambda g: g.area)
+    return shapely.orient_polygons(out) if hasattr(shapely, "orient_polygons") else _orient(out)
+
+
+def _snap(loop: np.ndarray, tol: float = 1e-6) -> np.ndarray:
+    """Drop points closer than ``tol`` mm to the previous one (a closed loop: also last to first)."""
+    loop = np.asarray(loop, dtype=np.float64)
+    keep = np.ones(len(loop), dtype=bool)
+    d = np.linalg.norm(np.diff(loop, axis=0), axis=1)
+    keep[1:] = d > tol
+    loop = loop[keep]
+    if len(loop) > 3 and np.linalg.norm(loop[-1] - loop[0]) <= tol:
+        loop = loop[:-1]
+    return loop
+
+
+def _allowance_lookup(seam_allowance, seam_ids, path):
+    """A function ``seam id or None -> allowance, mm`` from a number or a mapping."""
+    if isinstance(seam_allowance, (int, float)) and not isinstance(seam_allowance, bool):
+        value = float(seam_allowance)
+        if not np.isfinite(value) or value < 0:
+            raise InputError(f"{path}: seam_allowance must be a number >= 0 mm, got {seam_allowance!r}")
+        return lambda seam: value
+    if hasattr(seam_allowance, "items"):
+        table = {}
+        for key, value in seam_allowance.items():
+            if key is not None and key not in seam_ids:
+                raise InputError(f"{path}: seam_allowance names seam {key!r}, which the pattern does not have "
+                                 f"(seams {sorted(seam_ids)}; None for every other edge)")
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
+                raise InputError(f"{path}: seam_allowance[{key!r}] must be a number >= 0 mm, got {value!r}")
+            table[key] = float(value)
+        default = table.get(None, 0.0)
+        return lambda seam: table.get(seam, default)
+    raise InputError(f"{path}: seam_allowance must be a number (mm) or a mapping of seam ids to mm, "
+                     f"got {type(seam_allowance).__name__}")
+
+
+def _readable_angle(direction) -> float:
+    angle = float(np.degrees(np.arctan2(direction[1], direction[0])))
+    if angle > 90:
+        angle -= 180
+    elif angle <= -90:
+        angle += 180
+    return angle
+
+
+def _seam_annotations(pattern, geo):
+    """``(text, position (2,), angle degrees)`` for every seam side on the panel, at its middle, inside."""
+    import shapely
+
+    out = []
+    for fs in pattern.seams:
+        seam = fs.seam
+        for side, (p, idx) in enumerate(zip(seam.panels, seam.vertices)):
+            if p != geo.index:
+                continue
+            pts = geo.uv[idx]
+            mid = len(pts) // 2
+            a, b = pts[max(mid - 1, 0)], pts[min(mid + 1, len(pts) - 1)]
+            tangent = (b - a) / max(np.linalg.norm(b - a), 1e-12)
+            normal = np.array([-tangent[1], tangent[0]])
+            at = pts[mid] + 1.6 * geo.text_height * normal
+            if not shapely.contains_xy(geo.polygon, *at):
+                at = pts[mid] - 1.6 * geo.text_height * normal
+            text = seam_label(fs, side)
+            out.append((text, at, _readable_angle(tangent)))
+    return out
+
+
+def seam_label(flat_seam, side: int) -> str:
+    """The annotation written next to a seam: id, 3D length and this side's flat length (0.01 mm)."""
+    return (f"S{flat_seam.seam.id} 3D {flat_seam.length:.2f} FLAT {flat_seam.flat_lengths[side]:.2f} MM")
+
+
+def _notches(pattern, geo, allowance_of):
+    """``(point on the seam line (2,), outward normal (2,), depth)`` at both ends of every seam on the panel."""
+    out = []
+    for fs in pattern.seams:
+        seam = fs.seam
+        for p, idx in zip(seam.panels, seam.vertices):
+            if p != geo.index:
+                continue
+            pts = geo.uv[idx]
+            for end, nxt in ((0, 1), (-1, -2)):
+                t = pts[nxt] - pts[end]
+                t = t / max(np.linalg.norm(t), 1e-12)
+                normal = np.array([t[1], -t[0]]) if end == 0 else np.array([-t[1], t[0]])
+                # Outward = away from the panel: check with a small step.
+                import shapely
+
+                probe = pts[end] + 0.5 * np.mean(np.linalg.norm(np.diff(pts, axis=0), axis=1)) * normal
+                if shapely.contains_xy(geo.polygon, *probe):
+                    normal = -normal
+                depth = allowance_of(seam.id)
+                out.append((pts[end], normal, depth if depth > 0 else 3.0, depth > 0))
+    return out
+
+
+def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance=0.0, units: str = "mm",
+                      version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
+                      gap: float | None = None) -> None:
+    """Write a whole pattern as a DXF for cutters.
+
+    See :meth:`patterns.Pattern.to_dxf` and docs/dxf.md for the two profiles.
+    """
+    import ezdxf
+
+    from .heatmap import display_offsets
+
+    if profile not in PROFILES:
+        raise InputError(f"{path}: unknown DXF profile {profile!r}; choose one of {', '.join(PROFILES)}")
+    if units not in UNITS:
+        raise InputError(f"{path}: unknown unit {units!r}; choose one of {', '.join(UNITS)}")
+    if profile == "astm":
+        if version not in (None, "R12"):
+            raise InputError(f"{path}: the ASTM profile is written as R12 only, not {version!r}")
+        if units != "mm":
+            raise InputError(f"{path}: the ASTM profile is written in mm (METRIC) only")
+        version = "R12"
+    version = version or "R2000"
+    if version not in MACHINE_VERSIONS:
+        raise InputError(f"{path}: unknown DXF version {version!r}; choose one of {', '.join(MACHINE_VERSIONS)}")
+    if text_height is not None and not (isinstance(text_height, (int, float)) and text_height > 0):
+        raise InputError(f"{path}: text_height must be a positive number of mm, got {text_height!r}")
+    allowance_of = _allowance_lookup(seam_allowance, {s.seam.id for s in pattern.seams}, path)
+    scale = {"mm": 1.0, "cm": 0.1, "m": 0.001, "in": 1 / 25.4}[units]
+    biggest = max(float(np.max(_allowance_values(pattern, allowance_of))), 0.0)
+    offsets = display_offsets(pattern, gap=gap if gap is not None else None, margin=biggest)
+    geos = [_PanelGeometry(pattern, i, offsets[i], allowance_of, text_height) for i in range(len(pattern.panels))]
+    if profile == "machine":
+        doc = _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer)
+        with atomic_output(path, what="DXF file") as tmp:
+            doc.saveas(tmp)
+    else:
+        from ezdxf.addons import gerber_D6673
+
+        doc = _astm_doc(ezdxf, pattern, geos, allowance_of)
+        with atomic_output(path, what="DXF file") as tmp:
+            gerber_D6673.export_file(doc, tmp)
+
+
+def _allowance_values(pattern, allowance_of):
+    return [allowance_of(None)] + [allowance_of(s.seam.id) for s in pattern.seams]
+
+
+def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer):
+    r12 = version == "R12"
+    doc = _new_doc(ezdxf, version, 0 if r12 else UNITS[units])
+    if not r12:
+        doc.header["$INSUNITS"] = UNITS[units]
+    doc.header["$MEASUREMENT"] = 0 if units == "in" else 1
+    for name, color in MACHINE_LAYERS.items():
+        if name != "STRAIN" or strain_layer:
+            doc.layers.add(name, color=color)
+    msp = doc.modelspace()
+
+    def poly(points, layer, close=True):
+        pts = (np.asarray(points) * scale).tolist()
+        if r12:
+            msp.add_polyline2d(pts, close=close, dxfattribs={"layer": layer})
+        else:
+            msp.add_lwpolyline(pts, close=close, dxfattribs={"layer": layer})
+
+    def text(s, at, height, angle=0.0, layer="LABEL"):
+        msp.add_text(s, height=height * scale, rotation=angle,
+                     dxfattribs={"layer": layer}).set_placement(tuple(np.asarray(at) * scale),
+                                                                  align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+
+    for g in geos:
+        for loop in g.cut_loops:
+            poly(loop, "CUT")
+        if g.has_allowance:
+            for loop in g.seam_loops:
+                poly(loop, "SEW")
+        for point, normal, depth, outward in _notches(pattern, g, allowance_of):
+            end = point + (normal if outward else -normal) * depth
+            msp.add_line(tuple(point * scale), tuple(end * scale), dxfattribs={"layer": "NOTCH"})
+        a, b = _grain_line(g)
+        msp.add_line(tuple(np.asarray(a) * scale), tuple(np.asarray(b) * scale), dxfattribs={"layer": "GRAIN"})
+        text(g.name, g.label_at + [0.0, 0.8 * g.text_height], 1.2 * g.text_height)
+        text(f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%",
+             g.label_at - [0.0, 0.9 * g.text_height], 0.7 * g.text_height)
+        for s, at, angle in _seam_annotations(pattern, g):
+            text(s, at, 0.6 * g.text_height, angle)
+        if strain_layer:
+            _strain_solids(msp, pattern.panels[g.index], g.uv, scale, truecolor=version not in ("R12", "R2000"))
+    if r12:
+        text(f"UNITS: {units.upper()}", [geos[0].box[0], geos[0].box[1] - 3 * geos[0].text_height],
+             geos[0].text_height)
+    return doc
+
+
+def _new_doc(ezdxf, version, units):
+    """``ezdxf.new`` without its warning that R12 has no ``$INSUNITS`` (we know, and say it in a text)."""
+    import logging
+
+    log = logging.getLogger("ezdxf")
+    level = log.level
+    log.setLevel(logging.ERROR)
+    try:
+        return ezdxf.new(version, setup=False, units=units)
+    finally:
+        log.setLevel(level)
+
+
+def _grain_line(g):
+    """A grain line along the flat +v axis, beside the labels where there is room.
+
+    (Until a grain direction is given, the flat +v axis is the grain.)
+    """
+    h = 0.3 * (g.box[3] - g.box[1])
+    for dx in (12.0, -12.0, 0.0):
+        base = g.label_at + np.array([dx * g.text_height, -0.5 * h])
+        if _inside(g.polygon, base) and _inside(g.polygon, base + [0.0, h]):
+            break
+    return (float(base[0]), float(base[1])), (float(base[0]), float(base[1] + h))
+
+
+def _inside(polygon, point) -> bool:
+    import shapely
+
+    return bool(shapely.contains_xy(polygon, *point))
+
+
+def _strain_solids(msp, flat, uv, scale, truecolor):
+    """Every triangle as a filled SOLID coloured by its dominant strain (layer STRAIN)."""
+    from matplotlib import colormaps
+    from matplotlib.colors import TwoSlopeNorm
+
+    from ..measure import triangle_strains
+
+    s = triangle_strains(flat.vertices, flat.faces, flat.uv).dominant
+    lim = max(float(np.max(np.abs(s))), 1e-6)
+    rgba = colormaps["RdBu_r"](TwoSlopeNorm(0.0, -lim, lim)(s))
+    for tri, c in zip(flat.faces, rgba):
+        p = uv[tri] * scale
+        attribs = {"layer": "STRAIN"}
+        if truecolor:
+            from ezdxf.colors import rgb2int
+
+            attribs["true_color"] = rgb2int(tuple(int(255 * x) for x in c[:3]))
+        else:
+            attribs["color"] = 5 if c[2] > c[0] else 1
+        msp.add_solid([tuple(p[0]), tuple(p[1]), tuple(p[2])], dxfattribs=attribs)
+
+
+def _astm_doc(ezdxf, pattern, geos, allowance_of):
+    """ASTM D6673 (AAMA) R12 document: one block per piece, inserted on layer 1."""
+    doc = _new_doc(ezdxf, "R12", 0)
+    for layer in ASTM_LAYERS:
+        doc.layers.add(str(layer))
+    msp = doc.modelspace()
+    used = set()
+    for g in geos:
+        name = _block_name(g.name, used)
+        block = doc.blocks.new(name=name)
+        outer, holes = g.cut_loops[0], g.cut_loops[1:]
+        block.add_polyline2d(outer.tolist(), close=True, dxfattribs={"layer": "1"})
+        for loop in holes:
+            block.add_polyline2d(loop.tolist(), close=True, dxfattribs={"layer": "11"})
+        for loop in g.cut_loops:
+            turn = _turning(loop)
+            for p, t in zip(loop, turn):
+                block.add_point((float(p[0]), float(p[1])), dxfattribs={"layer": "2" if t > np.radians(20) else "3"})
+        if g.has_allowance:
+            for loop in g.seam_loops:
+                block.add_polyline2d(loop.tolist(), close=True, dxfattribs={"layer": "14"})
+        for point, normal, depth, outward in _notches(pattern, g, allowance_of):
+            # ASTM notch: a POINT on the cut line; z = depth, group 50 = angle (into the piece).
+            base = point + normal * depth if outward else point
+            inward = -normal
+            angle = float(np.degrees(np.arctan2(inward[1], inward[0])))
+            block.add_point((float(base[0]), float(base[1]), float(depth)),
+                            dxfattribs={"layer": "4", "angle": angle})
+        block.add_line(*_grain_line(g), dxfattribs={"layer": "7"})
+        th = g.text_height
+        lines = [f"Piece Name:{g.name}", "Quantity:1", "Material:", f"Style Name:{pattern.name}", "Units:METRIC"]
+        for k, s in enumerate(lines):
+            block.add_text(s, height=0.6 * th, dxfattribs={"layer": "1"}).set_placement(
+                tuple(g.label_at + [0.0, (1.5 - k) * th]), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+        block.add_text(f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%", height=0.6 * th,
+                       dxfattribs={"layer": "15"}).set_placement(
+            tuple(g.label_at - [0.0, 4.0 * th]), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+        for s, at, angle in _seam_annotations(pattern, g):
+            block.add_text(s, height=0.6 * th, rotation=angle, dxfattribs={"layer": "15"}).set_placement(
+                tuple(at), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+        msp.add_blockref(name, (0.0, 0.0), dxfattribs={"layer": "1"})
+    return doc
+
+
+def _block_name(name: str, used: set) -> str:
+    import re
+
+    base = re.sub(r"[^A-Za-z0-9_\-]", "_", name)[:31] or "PIECE"
+    out, k = base, 1
+    while out.upper() in used:
+        k += 1
+        out = f"{base[:28]}_{k}"
+    used.add(out.upper())
+    return out
+
+
+def _turning(loop: np.ndarray) -> np.ndarray:
+    """Turning angle at every vertex of a closed polyline, radians (0 = straight on)."""
+    a = loop - np.roll(loop, 1, axis=0)
+    b = np.roll(loop, -1, axis=0) - loop
+    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    dot = (a * b).sum(axis=1)
+    return np.abs(np.arctan2(cross, dot))
+
+
+def _orient(polygon):
+    """Exterior counter-clockwise, interiors clockwise (shapely < 2.1)."""
+    from shapely.geometry.polygon import orient
+
+    return orient(polygon, 1.0)

@@ -21,16 +21,19 @@ HEAT_MAP_FORMATS = (".png", ".svg")
 """File suffixes :func:`heat_map` writes."""
 
 
-def display_offsets(pattern, *, gap: float | None = None) -> np.ndarray:
-    """Where to draw each panel when the pattern is not laid out: rows of bounding boxes.
+def display_offsets(pattern, *, gap: float | None = None, margin: float = 0.0) -> np.ndarray:
+    """Where to put each panel when the pattern is not laid out: rows of bounding boxes.
 
-    Only for pictures; the pattern is not changed.  Returns ``(k, 2)`` mm offsets
-    (all zero once the pattern is laid out: then its placement is drawn).
+    For pictures and for DXF files of a pattern that was never laid out: only
+    translations, nothing scaled or turned; the pattern itself is not changed.
+    ``margin`` (mm) is added around every box (room for a seam allowance).
+    Returns ``(k, 2)`` mm offsets (all zero once the pattern is laid out: then
+    its placement is used).
     """
     panels = pattern.panels
     if pattern.laid_out:
         return np.zeros((len(panels), 2))
-    boxes = np.array([np.r_[p.uv.min(axis=0), p.uv.max(axis=0)] for p in panels])
+    boxes = np.array([np.r_[p.uv.min(axis=0) - margin, p.uv.max(axis=0) + margin] for p in panels])
     sizes = boxes[:, 2:] - boxes[:, :2]
     if gap is None:
         gap = 0.08 * float(np.max(sizes))

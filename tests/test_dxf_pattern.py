@@ -1,0 +1,333 @@
+"""Pattern DXF files for cutters: machine and ASTM profiles, read back by ezdxf and by
+real readers (LibreCAD, dxf2gcode, FreeCAD) where they are installed."""
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import zlib
+from pathlib import Path
+
+import ezdxf
+import numpy as np
+import pytest
+import shapely
+from ezdxf import recover
+
+import patterns
+from patterns.errors import ExportError, InputError
+from patterns.export.dxf import MACHINE_LAYERS
+from patterns.export.preview import preview_dxf
+
+from .conftest import SAMPLES
+
+READERS = Path(__file__).parent / "readers"
+
+
+@pytest.fixture(scope="module")
+def cup():
+    return patterns.flatten(patterns.load(SAMPLES / "cup.step"))
+
+
+@pytest.fixture(scope="module")
+def plate():
+    """A box with a through hole: planar panels with holes, a cylindrical wall."""
+    import build123d as bd
+
+    return patterns.flatten(patterns.load(bd.Box(200, 100, 50) - bd.Cylinder(20, 50), max_edge=10))
+
+
+def read(path):
+    doc, auditor = recover.readfile(str(path))
+    assert not auditor.has_errors, [str(e) for e in auditor.errors]
+    return doc
+
+
+def polylines(doc, layer):
+    out = []
+    for e in doc.modelspace().query(f'LWPOLYLINE POLYLINE[layer=="{layer}"]'):
+        if e.dxftype() == "LWPOLYLINE":
+            pts, closed = np.array([p[:2] for p in e.get_points("xy")]), e.closed
+        else:
+            pts, closed = np.array([tuple(v.dxf.location)[:2] for v in e.vertices]), e.is_closed
+        out.append((pts, closed))
+    return out
+
+
+def ring_numbers(pts):
+    ring = shapely.Polygon(pts)
+    return abs(ring.area), ring.exterior.length
+
+
+@pytest.mark.parametrize("version", ["R12", "R2000", "R2018"])
+def test_machine_cut_contours_are_the_flat_outlines(plate, tmp_path, version):
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, version=version)
+    doc = read(path)
+    assert doc.dxfversion == ezdxf.const.acad_release_to_dxf_version[version]
+    cuts = polylines(doc, "CUT")
+    loops = [loop for flat in plate.panels for loop in flat.loops]
+    assert len(cuts) == len(loops) and all(closed for _, closed in cuts)
+    # Every flat loop appears once, with its area and perimeter, within 1e-6 (relative).
+    expected = sorted(ring_numbers(flat.uv[loop]) for flat in plate.panels for loop in flat.loops)
+    found = sorted(ring_numbers(pts) for pts, _ in cuts)
+    np.testing.assert_allclose(found, expected, rtol=1e-6)
+    # z = 0 everywhere, 1:1, units declared, text never on CUT, layers as documented.
+    for e in doc.modelspace():
+        assert e.dxf.layer in MACHINE_LAYERS
+        if e.dxftype() in ("TEXT", "MTEXT"):
+            assert e.dxf.layer == "LABEL"
+        if e.dxftype() == "LINE":
+            assert e.dxf.start.z == 0 and e.dxf.end.z == 0
+        if e.dxftype() == "POLYLINE":
+            assert all(v.dxf.location.z == 0 for v in e.vertices)
+    if version != "R12":
+        assert doc.header["$INSUNITS"] == 4
+    else:
+        assert any(t.dxf.text == "UNITS: MM" for t in doc.modelspace().query("TEXT"))
+    # No two cut contours are the same (nothing gets cut twice), no panels overlap.
+    polys = [shapely.Polygon(p) for p, _ in cuts]
+    outers = [p for p in polys if not any(q.contains(p) for q in polys if q is not p)]
+    for i, a in enumerate(outers):
+        for b in outers[i + 1:]:
+            assert a.intersection(b).area < 1e-9
+
+
+def test_seam_annotations_equal_the_report(cup, tmp_path):
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path)
+    report = patterns.check(cup)
+    texts = [t.dxf.text for t in read(path).modelspace().query('TEXT[layer=="LABEL"]')]
+    seams = [re.fullmatch(r"S(\d+) 3D ([\d.]+) FLAT ([\d.]+) MM", t) for t in texts]
+    seams = [m for m in seams if m]
+    assert len(seams) == 2 * len(report.seams)  # each seam labelled on both sides
+    for m in seams:
+        numbers = report.seams[int(m.group(1))]
+        assert float(m.group(2)) == round(numbers.length_3d, 2)
+        assert float(m.group(3)) in {round(x, 2) for x in numbers.length_flat}
+    for panel in report.panels:
+        assert panel.name in texts
+        assert f"STRAIN RMS {100 * panel.strain_rms:.2f}% MAX {100 * panel.strain_max:.2f}%" in texts
+
+
+def test_seam_allowance_offsets_the_cut_line_and_keeps_the_seam_line(cup, tmp_path):
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, seam_allowance=10.0)
+    doc = read(path)
+    sews, cuts = polylines(doc, "SEW"), polylines(doc, "CUT")
+    assert len(cuts) == len(sews) == 4
+    for (sew, _), (cut, closed) in zip(sorted(sews, key=lambda x: x[0][:, 0].min()),
+                                       sorted(cuts, key=lambda x: x[0][:, 0].min())):
+        assert closed
+        seam_line, cut_line = shapely.Polygon(sew), shapely.Polygon(cut)
+        assert cut_line.contains(seam_line)
+        # Every point of the seam line is 10 mm inside the cut line (mitred corners
+        # are farther only at the corners).
+        d = shapely.distance(shapely.points(sew), cut_line.exterior)
+        assert np.median(d) == pytest.approx(10.0, abs=1e-4) and d.min() > 10.0 - 1e-4
+    # Per seam: 15 mm on seam 0, 5 mm elsewhere.
+    path2 = tmp_path / "cup2.dxf"
+    cup.to_dxf(path2, seam_allowance={0: 15.0, None: 5.0})
+    doc2 = read(path2)
+    seam0 = cup.seams[0].seam
+    panel = seam0.panels[0]
+    offset = np.array(_placed_offset(doc2, cup, panel))
+    on_seam = cup.panels[panel].uv[seam0.vertices[0]][3:-3] + offset
+    cut_line = max((shapely.Polygon(p) for p, _ in polylines(doc2, "CUT")),
+                   key=lambda poly: -poly.distance(shapely.Point(on_seam[len(on_seam) // 2])))
+    d = shapely.distance(shapely.points(on_seam), cut_line.exterior)
+    np.testing.assert_allclose(d, 15.0, atol=1e-4)
+
+
+def _placed_offset(doc, pattern, panel):
+    """Where the writer put a panel: the SEW loop with the panel's area and shape, minus its flat position."""
+    flat = pattern.panels[panel]
+    loop = flat.uv[flat.loops[0]]
+    for pts, _ in polylines(doc, "SEW"):
+        if len(pts) == len(loop) and np.allclose(np.diff(pts, axis=0), np.diff(loop, axis=0), atol=1e-6):
+            return pts[0] - loop[0]
+    raise AssertionError("panel not found")
+
+
+def test_notches_mark_both_ends_of_every_seam(cup, tmp_path):
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, seam_allowance=8.0)
+    notches = read(path).modelspace().query('LINE[layer=="NOTCH"]')
+    assert len(notches) == 2 * 2 * len(cup.seams)
+    for line in notches:
+        assert line.dxf.start.distance(line.dxf.end) == pytest.approx(8.0)
+
+
+def test_astm_profile_is_piece_blocks_for_garment_cad(cup, tmp_path):
+    path = tmp_path / "cup_astm.dxf"
+    cup.to_dxf(path, profile="astm", seam_allowance=10.0)
+    text = path.read_text(encoding="ascii")
+    # What Gerber's parser wants: no handles, no layout blocks, an empty header.
+    assert "$MODEL_SPACE" not in text.upper() and "$PAPER_SPACE" not in text.upper()
+    doc = read(path)
+    assert doc.dxfversion == "AC1009"
+    inserts = doc.modelspace().query("INSERT")
+    assert len(inserts) == len(doc.modelspace()) == 4
+    for insert, flat in zip(inserts, cup.panels):
+        assert insert.dxf.layer == "1" and insert.dxf.name == flat.name
+        block = doc.blocks[insert.dxf.name]
+        layers = {e.dxf.layer for e in block}
+        assert {"1", "2", "3", "4", "7", "14"} <= layers
+        (cut,) = [e for e in block.query("POLYLINE") if e.dxf.layer == "1"]
+        (sew,) = [e for e in block.query("POLYLINE") if e.dxf.layer == "14"]
+        assert cut.is_closed and sew.is_closed
+        sew_pts = np.array([tuple(v.dxf.location)[:2] for v in sew.vertices])
+        assert ring_numbers(sew_pts) == pytest.approx(ring_numbers(flat.uv[flat.loops[0]]), rel=1e-6)
+        piece = {t.dxf.text for t in block.query("TEXT") if t.dxf.layer == "1"}
+        assert {f"Piece Name:{flat.name}", "Quantity:1", "Material:", "Units:METRIC"} <= piece
+        notches = [e for e in block.query("POINT") if e.dxf.layer == "4"]
+        assert len(notches) == 4  # two seams, two ends each
+        for n in notches:
+            assert n.dxf.location.z == pytest.approx(10.0)  # notch depth = the allowance
+            assert n.dxf.hasattr("angle")
+        assert len(block.query('LINE[layer=="7"]')) == 1  # grain line
+
+
+def test_preview_is_the_file_at_one_to_one(cup, tmp_path):
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, seam_allowance=10.0)
+    extents = ezdxf.bbox.extents(read(path).modelspace())
+    svg = tmp_path / "cup.svg"
+    preview_dxf(path, svg, margin=10.0)
+    head = svg.read_text()[:400]
+    width = float(re.search(r'width="([\d.]+)mm"', head).group(1))
+    height = float(re.search(r'height="([\d.]+)mm"', head).group(1))
+    assert width == pytest.approx(extents.size.x + 20.0, abs=0.1)
+    assert height == pytest.approx(extents.size.y + 20.0, abs=0.1)
+    png = tmp_path / "cup.png"
+    preview_dxf(path, png, dpi=50, margin=10.0)
+    import matplotlib.image
+
+    img = matplotlib.image.imread(png)
+    assert img.shape[1] == pytest.approx((extents.size.x + 20.0) / 25.4 * 50, abs=2)
+    # Red cut lines and blue sew lines are drawn (the layers' colours).
+    rgb = img[..., :3]
+    assert np.count_nonzero((rgb[..., 0] > 0.8) & (rgb[..., 1] < 0.3)) > 100
+    assert np.count_nonzero((rgb[..., 2] > 0.8) & (rgb[..., 0] < 0.3)) > 100
+    # The ASTM file renders too (its layers have no table: named for the preview).
+    astm = tmp_path / "astm.dxf"
+    cup.to_dxf(astm, profile="astm")
+    preview_dxf(astm, tmp_path / "astm.png", dpi=30)
+    dark = matplotlib.image.imread(tmp_path / "astm.png")[..., :3].mean(axis=2) < 0.5
+    assert np.count_nonzero(dark) > 500
+
+
+def test_strain_layer(cup, tmp_path):
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, strain_layer=True, version="R2004")
+    doc = read(path)
+    solids = doc.modelspace().query('SOLID[layer=="STRAIN"]')
+    assert len(solids) == sum(len(p.faces) for p in cup.panels)
+    assert all(s.dxf.hasattr("true_color") for s in solids)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"profile": "gerber"}, "unknown DXF profile"),
+        ({"units": "furlong"}, "unknown unit"),
+        ({"version": "R14"}, "unknown DXF version"),
+        ({"profile": "astm", "version": "R2000"}, "R12 only"),
+        ({"profile": "astm", "units": "in"}, "METRIC"),
+        ({"seam_allowance": -1.0}, "seam_allowance"),
+        ({"seam_allowance": {99: 5.0}}, "does not have"),
+        ({"seam_allowance": "wide"}, "seam_allowance"),
+    ],
+)
+def test_bad_options_write_nothing(cup, tmp_path, kwargs, words):
+    path = tmp_path / "out.dxf"
+    with pytest.raises(InputError, match=words):
+        cup.to_dxf(path, **kwargs)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_failed_export_leaves_no_file(cup, tmp_path):
+    with pytest.raises(ExportError, match="does not exist"):
+        cup.to_dxf(tmp_path / "missing" / "cup.dxf")
+    assert list(tmp_path.iterdir()) == []
+
+
+# --------------------------------------------------------------------------- #
+# Real readers (installed by .ci/run from the distribution's packages)
+# --------------------------------------------------------------------------- #
+
+
+def _need(tool):
+    if shutil.which(tool) is None:
+        pytest.skip(f"{tool} is not installed (.ci/run installs it with apt-get)")
+
+
+def _qt_env(tmp_path):
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(tmp_path), HOME=str(tmp_path))
+    return env
+
+
+@pytest.mark.parametrize("version", ["R12", "R2000"])
+def test_librecad_renders_the_file(plate, tmp_path, version):
+    _need("librecad")
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, version=version)
+    pdf = tmp_path / "plate.pdf"  # dxf2pdf writes FILE.pdf beside FILE.dxf
+    # --fit: at the default 1:1 on A4 the 450 x 355 mm sheet falls off the page.
+    proc = subprocess.run(["librecad", "dxf2pdf", "--fit", str(path)], capture_output=True, text=True,
+                          env=_qt_env(tmp_path), timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = pdf.read_bytes()
+    content = b"".join(_inflate(s) for s in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, re.S))
+    # Drawn as vector paths: at least one line-to for every cut vertex.
+    n_vertices = sum(len(loop) for flat in plate.panels for loop in flat.loops)
+    assert len(re.findall(rb"\sl\s", content)) >= n_vertices
+
+
+def _inflate(stream: bytes) -> bytes:
+    try:
+        return zlib.decompress(stream)
+    except zlib.error:
+        return stream
+
+
+@pytest.mark.parametrize("version", ["R12", "R2000"])
+def test_dxf2gcode_finds_one_closed_contour_per_cut_loop(plate, tmp_path, version):
+    _need("dxf2gcode")
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, version=version, seam_allowance=5.0)
+    proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
+                          capture_output=True, text=True, env=_qt_env(tmp_path), timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    found = json.loads(proc.stdout.strip().splitlines()[-1])
+    n_loops = len(polylines(read(path), "CUT"))
+    assert found["entities"]["CUT"] == {"contours": n_loops, "closed": n_loops}
+    assert found["metric"] is True
+
+
+def test_freecad_reads_the_machine_profile(plate, tmp_path):
+    _need("freecadcmd")
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path)
+    proc = subprocess.run(["freecadcmd", str(READERS / "freecad_layers.py")], capture_output=True, text=True,
+                          env=dict(_qt_env(tmp_path), DXF=str(path)), timeout=300)
+    lines = [x for x in proc.stdout.splitlines() if "RESULT " in x]
+    assert lines, proc.stdout[-2000:] + proc.stderr[-2000:]
+    layers = json.loads(lines[-1].split("RESULT ", 1)[1])
+    wires = layers["CUT"]["closed_wires"]
+    expected = sorted(ring_numbers(flat.uv[loop]) for flat in plate.panels for loop in flat.loops)
+    assert len(wires) == len(expected)
+    found = sorted((w["area"], w["length"]) for w in wires)
+    np.testing.assert_allclose(found, expected, rtol=1e-6)
+    assert {"GRAIN", "NOTCH"} <= set(layers)
+
+
+def test_readers_are_present_in_ci():
+    """In CI (.ci/run sets PATTERNS_REQUIRE_READERS=1) the readers must be installed, not skipped."""
+    if os.environ.get("PATTERNS_REQUIRE_READERS") != "1":
+        pytest.skip("PATTERNS_REQUIRE_READERS is not set (only .ci/run requires the real readers)")
+    missing = [t for t in ("librecad", "dxf2gcode", "freecadcmd") if shutil.which(t) is None]
+    assert not missing, f"readers missing in CI: {missing}"
+    assert sys.platform.startswith("linux")
