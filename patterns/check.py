@@ -215,6 +215,10 @@ class SeamReport:
     """Names of the panels on side 0 and side 1 (equal for a seam closing one panel)."""
     cad_edge: int | None
     length_3d: float
+    """The seam's exact length (the CAD edge's curve length)."""
+    length_3d_polyline: float
+    """The 3D length of the polyline the flat lengths are measured along (shorter than
+    ``length_3d`` on a curve by the chords' sag): compare flat lengths with this."""
     length_flat: tuple
     """Flat length on side 0 and on side 1."""
     mismatch: float
@@ -365,7 +369,7 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
         seam = fs.seam
         names = tuple(pattern.panels[p].name for p in seam.panels)
         pct = 100.0 * fs.mismatch / seam.length if seam.length > 0 else 0.0
-        seam_reports.append(SeamReport(seam.id, names, seam.cad_edge, float(seam.length),
+        seam_reports.append(SeamReport(seam.id, names, seam.cad_edge, float(seam.length), seam.polyline_length,
                                        tuple(float(x) for x in fs.flat_lengths), fs.mismatch, pct))
         if max_seam_mismatch is not None and abs(fs.mismatch) > max_seam_mismatch:
             mid = pattern.panels[seam.panels[0]].uv[seam.vertices[0][len(seam.vertices[0]) // 2]]

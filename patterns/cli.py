@@ -1,14 +1,25 @@
 """The ``patterns`` command line.
 
-``patterns flatten INPUT -o OUT`` flattens a mesh file and writes the cut
-contours (.dxf) or the flat mesh (.obj), printing the strain and the overlap
-verdict.  Exit codes: 0 done, 2 bad input or usage (one line on stderr; add
-``--debug`` for the traceback).
+Subcommands::
+
+    patterns flatten INPUT -o OUT.dxf [--profile machine|astm] [--method ...] [--max-edge MM]
+                     [--seam-allowance MM] [--max-strain R] [--report OUT.json] [--preview OUT.png]
+                     [--heat-map OUT.png]
+    patterns check INPUT [--max-strain R] [--max-seam-mismatch MM] [--report OUT.json]
+    patterns info INPUT
+    patterns demo [-o DIR]
+    patterns batch DIR -o OUTDIR [--jobs N] [--scheduler ADDRESS]
+
+Exit codes: 0 done, 1 the pattern fails a check the user asked for
+(``--max-strain``, ``--max-seam-mismatch``) or has an overlap, 2 bad input or
+usage (one line on stderr; ``--debug`` shows the traceback).  Heavy imports
+happen inside the commands.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -17,58 +28,390 @@ from .errors import InputError, PatternsError
 
 __all__ = ["main"]
 
+EXIT_OK, EXIT_CHECK, EXIT_INPUT = 0, 1, 2
+"""Exit codes."""
+
 OUTPUT_SUFFIXES = (".dxf", ".obj")
+
+
+class Progress:
+    """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
+
+    def __init__(self, label: str, *, stream=None, enabled: bool | None = None):
+        self.stream = stream or sys.stderr
+        self.enabled = self.stream.isatty() if enabled is None else enabled
+        self.label = label
+        self._last = -1.0
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled or total <= 0:
+            return
+        frac = min(max(done / total, 0.0), 1.0)
+        if frac - self._last < 0.01 and frac < 1.0:
+            return
+        self._last = frac
+        width = 30
+        bar = "#" * int(frac * width) + "-" * (width - int(frac * width))
+        self.stream.write(f"\r{self.label} [{bar}] {100 * frac:3.0f}%")
+        if frac >= 1.0:
+            self.stream.write("\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.enabled and 0 <= self._last < 1.0:
+            self.stream.write("\n")
+            self.stream.flush()
 
 
 def _parser() -> argparse.ArgumentParser:
     from . import METHODS, __version__
-    from .export.dxf import UNITS
+    from .export.dxf import MACHINE_VERSIONS, PROFILES, UNITS
 
     parser = argparse.ArgumentParser(
-        prog="patterns", description="Flatten 3D surfaces into true-scale 2D cutting patterns."
+        prog="patterns", description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns."
     )
     parser.add_argument("--version", action="version", version=f"patterns {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    flat = sub.add_parser("flatten", help="flatten a mesh file (.obj .stl .ply .off)")
-    flat.add_argument("input", type=Path, help="mesh file; coordinates taken in --units")
+
+    def loading(p):
+        p.add_argument("input", type=Path,
+                       help="CAD file (.step .stp .brep .iges .igs) or mesh file (.stl .obj .ply .off .3mf)")
+        p.add_argument("--max-edge", type=float, default=None, help="CAD: target triangle edge length, mm")
+        p.add_argument("--tolerance", type=float, default=0.05, help="CAD: chordal tolerance, mm (default 0.05)")
+        p.add_argument("--units", choices=tuple(UNITS), default="mm",
+                       help="mesh files: unit of the coordinates (CAD files carry their own); also the DXF's unit")
+
+    def flattening(p):
+        p.add_argument("--method", choices=METHODS, default="relaxed", help="flattening method (default relaxed)")
+        p.add_argument("--max-iterations", type=int, default=500, help="relaxation iterations at most (default 500)")
+
+    def checking(p):
+        p.add_argument("--max-strain", type=float, default=None,
+                       help="largest acceptable strain, a ratio (0.03 = 3 %%); above it the exit code is 1")
+        p.add_argument("--max-seam-mismatch", type=float, default=None,
+                       help="largest acceptable difference of a seam's two flat lengths, mm; above it exit code 1")
+        p.add_argument("--report", type=Path, default=None, help="write the JSON report here")
+
+    def output(p):
+        p.add_argument("--profile", choices=PROFILES, default="machine",
+                       help="DXF dialect: machine (laser, plasma, knife) or astm (garment CAD); default machine")
+        p.add_argument("--seam-allowance", type=float, default=0.0, help="seam allowance on every edge, mm")
+        p.add_argument("--dxf-version", choices=tuple(MACHINE_VERSIONS), default=None,
+                       help="machine profile: DXF version (default R2000)")
+
+    flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, or .obj for one panel)")
+    loading(flat)
     flat.add_argument("-o", "--output", type=Path, required=True,
-                      help="output: .dxf (cut contours on layer CUT) or .obj (flat mesh, z = 0)")
-    flat.add_argument("--method", choices=METHODS, default="relaxed", help="flattening method (default relaxed)")
-    flat.add_argument("--seed-face", type=int, default=None, help="face laid down first (default: farthest from the boundary)")
-    flat.add_argument("--max-iterations", type=int, default=500, help="relaxation iterations at most (default 500)")
-    flat.add_argument("--units", choices=tuple(UNITS), default="mm", help="unit of the input coordinates (default mm)")
+                      help="output: .dxf (the pattern for a cutter) or .obj (the flat mesh of a one-panel part)")
+    flattening(flat)
+    checking(flat)
+    output(flat)
+    flat.add_argument("--preview", type=Path, default=None, help="render the written DXF at 1:1 (.png or .svg)")
+    flat.add_argument("--heat-map", type=Path, default=None, help="strain heat map (.png or .svg)")
+
+    chk = sub.add_parser("check", help="flatten a part and report strain, seams and overlaps (no pattern file)")
+    loading(chk)
+    flattening(chk)
+    checking(chk)
+
+    info = sub.add_parser("info", help="list a part's panels, seams and areas (no flattening)")
+    loading(info)
+
+    demo = sub.add_parser("demo", help="run the whole pipeline on a bundled sample into ./patterns-demo/")
+    demo.add_argument("-o", "--output", type=Path, default=Path("patterns-demo"), help="folder (default ./patterns-demo)")
+
+    batch = sub.add_parser("batch", help="flatten every CAD and mesh file in a folder, in parallel")
+    batch.add_argument("folder", type=Path, help="folder of input files (not searched recursively)")
+    batch.add_argument("-o", "--output", type=Path, required=True, help="folder for the patterns and reports")
+    batch.add_argument("--jobs", type=int, default=None, help="parallel processes (default: the CPU count)")
+    batch.add_argument("--scheduler", default=None,
+                       help="run on a Dask distributed cluster at this address (needs patterns[dask])")
+    batch.add_argument("--max-edge", type=float, default=None, help="CAD: target triangle edge length, mm")
+    batch.add_argument("--tolerance", type=float, default=0.05, help="CAD: chordal tolerance, mm (default 0.05)")
+    flattening(batch)
+    batch.add_argument("--max-strain", type=float, default=None, help="largest acceptable strain (ratio)")
+    batch.add_argument("--max-seam-mismatch", type=float, default=None, help="largest acceptable seam mismatch, mm")
+    output(batch)
     return parser
 
 
-def _flatten(args) -> int:
-    from . import flatten_mesh
-    from .export import write_flat_obj, write_outline_dxf
-    from .load import read_mesh
+# --------------------------------------------------------------------------- #
+# The pipeline, shared by the commands
+# --------------------------------------------------------------------------- #
 
+
+def _load(args, *, progress=None):
+    from .load import CAD_SUFFIXES, MESH_SUFFIXES, load, mesh_model, read_mesh
+
+    path = args.input
+    suffix = path.suffix.lower()
+    if suffix in MESH_SUFFIXES and args.units != "mm":
+        scale = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}[args.units]
+        mesh = read_mesh(path)
+        return mesh_model(mesh.vertices * scale, mesh.faces, name=path.name)
+    if suffix in CAD_SUFFIXES or suffix in MESH_SUFFIXES:
+        return load(path, max_edge=args.max_edge, tolerance=args.tolerance)
+    return load(path)  # raises the one-line error for a missing file or unknown type
+
+
+def _flatten(model, args):
+    from .flatten import flatten
+
+    progress = Progress(f"flattening {len(model.panels)} panels")
+    try:
+        return flatten(model, method=args.method, max_iterations=args.max_iterations, progress=progress)
+    finally:
+        progress.close()
+
+
+def _check(pattern, args):
+    from .check import check
+
+    return check(pattern, max_strain=args.max_strain, max_seam_mismatch=args.max_seam_mismatch)
+
+
+def _print_panels(report, units_note=""):
+    rows = [("panel", "triangles", "area 3D mm2", "area flat mm2", "strain RMS %", "max %", "p95 %", "one-to-one")]
+    for p in report.panels:
+        rows.append((p.name, str(p.n_triangles), f"{p.area_3d:.1f}", f"{p.area_flat:.1f}",
+                     f"{100 * p.strain_rms:.2f}", f"{100 * p.strain_max:.2f}", f"{100 * p.strain_p95:.2f}",
+                     "yes" if p.one_to_one else "NO"))
+    _table(rows)
+    if report.seams:
+        rows = [("seam", "panels", "3D mm", "flat mm (side 0)", "flat mm (side 1)", "mismatch mm", "%")]
+        for s in report.seams:
+            rows.append((str(s.id), f"{s.panels[0]}/{s.panels[1]}", f"{s.length_3d:.2f}",
+                         f"{s.length_flat[0]:.2f}", f"{s.length_flat[1]:.2f}", f"{s.mismatch:+.2f}",
+                         f"{s.mismatch_percent:+.3f}"))
+        _table(rows)
+
+
+def _table(rows):
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    for r in rows:
+        print("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
+
+
+def _verdict(report) -> int:
+    print(str(report).splitlines()[0])
+    for f in report.findings:
+        print(f"  {f.severity.value}: {f.message}")
+    return EXIT_OK if report.ok else EXIT_CHECK
+
+
+# --------------------------------------------------------------------------- #
+# Commands
+# --------------------------------------------------------------------------- #
+
+
+def _cmd_flatten(args) -> int:
     suffix = args.output.suffix.lower()
     if suffix not in OUTPUT_SUFFIXES:
         raise InputError(f"{args.output}: unknown output type {suffix or '(none)'!r}; use .dxf or .obj")
-    mesh = read_mesh(args.input)
+    for label, value in (("--preview", args.preview), ("--heat-map", args.heat_map)):
+        if value is not None and value.suffix.lower() not in (".png", ".svg"):
+            raise InputError(f"{value}: {label} writes .png or .svg")
     start = time.perf_counter()
-    result = flatten_mesh(mesh.vertices, mesh.faces, method=args.method, seed_face=args.seed_face,
-                          max_iterations=args.max_iterations, name=str(args.input))
-    seconds = time.perf_counter() - start
+    model = _load(args)
+    loaded = time.perf_counter() - start
+    if suffix == ".obj" and len(model.panels) != 1:
+        raise InputError(f"{args.input}: {len(model.panels)} panels; a flat .obj holds one, write a .dxf")
+    print(f"{args.input}: {len(model.panels)} panels, {len(model.seams)} seams "
+          f"(target edge {model.max_edge:.3g} mm), loaded in {loaded:.2f} s")
+    start = time.perf_counter()
+    pattern = _flatten(model, args)
+    print(f"flattened ({args.method}) in {time.perf_counter() - start:.2f} s")
+    report = _check(pattern, args)
+    _print_panels(report)
     if suffix == ".dxf":
-        write_outline_dxf(args.output, [result.uv[loop] for loop in result.loops], units=args.units)
+        pattern.to_dxf(args.output, profile=args.profile, seam_allowance=args.seam_allowance, units=args.units,
+                       version=args.dxf_version)
+        print(f"wrote {args.output} ({args.profile} profile, {args.units})")
     else:
-        write_flat_obj(args.output, result.uv, result.faces)
-    d = result.distortion
-    u = args.units
-    welded = f", {mesh.n_welded} duplicate vertices welded" if mesh.n_welded else ""
-    print(f"{args.input}: {len(result.faces)} faces, {len(result.loops)} boundary loop(s){welded}")
-    how = f"{args.method}, from the {result.start} layout, {result.iterations} iterations" if result.start else args.method
-    print(f"flattened ({how}) in {seconds:.2f} s; wrote {args.output}")
-    print(f"edge strain: RMS {100 * d.edge_strain_rms:.3f} %, max {100 * d.edge_strain_max:.3f} %")
-    print(f"area: 3D {d.area_3d:.6g} {u}2, flat {d.area_flat:.6g} {u}2 ({100 * (d.area_ratio - 1):+.3f} %)")
-    print(f"boundary: 3D {d.boundary_3d:.6g} {u}, flat {d.boundary_flat:.6g} {u}")
-    print(f"overlap: {result.overlap.message}")
-    return 0
+        from .export import write_flat_obj
+
+        flat = pattern.panels[0]
+        write_flat_obj(args.output, flat.uv, flat.faces)
+        print(f"wrote {args.output} (flat mesh, z = 0)")
+    if args.report is not None:
+        report.to_json(args.report)
+        print(f"wrote {args.report}")
+    if args.heat_map is not None:
+        pattern.heat_map(args.heat_map)
+        print(f"wrote {args.heat_map}")
+    if args.preview is not None:
+        if suffix != ".dxf":
+            raise InputError(f"{args.preview}: --preview renders the DXF file; write a .dxf")
+        from .export.preview import preview_dxf
+
+        preview_dxf(args.output, args.preview)
+        print(f"wrote {args.preview} (the DXF at 1:1)")
+    return _verdict(report)
+
+
+def _cmd_check(args) -> int:
+    model = _load(args)
+    pattern = _flatten(model, args)
+    report = _check(pattern, args)
+    _print_panels(report)
+    if args.report is not None:
+        report.to_json(args.report)
+        print(f"wrote {args.report}")
+    return _verdict(report)
+
+
+def _cmd_info(args) -> int:
+    model = _load(args)
+    print(f"{args.input}: {len(model.panels)} panels, {len(model.seams)} seams, target edge {model.max_edge:.3g} mm")
+    rows = [("panel", "CAD faces", "vertices", "triangles", "outline loops", "area mm2")]
+    for p in model.panels:
+        rows.append((p.name, ",".join(map(str, p.cad_faces)) or "-", str(len(p.vertices)), str(len(p.faces)),
+                     str(len(p.loops)), f"{p.area:.1f}"))
+    _table(rows)
+    if model.seams:
+        rows = [("seam", "panels", "CAD edge", "length mm", "points")]
+        for s in model.seams:
+            rows.append((str(s.id), f"{model.panels[s.panels[0]].name}/{model.panels[s.panels[1]].name}",
+                         "-" if s.cad_edge is None else str(s.cad_edge), f"{s.length:.3f}", str(len(s.points))))
+        _table(rows)
+    return EXIT_OK
+
+
+def _cmd_demo(args) -> int:
+    from build123d import export_step
+
+    from .check import check
+    from .export.preview import preview_dxf
+    from .flatten import flatten
+    from .load import load
+    from .samples import cup
+
+    out = args.output
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"{out}: cannot create the demo folder ({exc.strerror})") from None
+    step = out / "cup.step"
+    export_step(cup(), step)
+    model = load(step)
+    pattern = flatten(model)
+    report = check(pattern, max_strain=0.05)
+    written = [(step, "the part: a hemisphere cup in four panels, built with build123d")]
+    pattern.to_dxf(out / "cup.dxf", seam_allowance=10.0)
+    written.append((out / "cup.dxf", "cutting pattern, machine profile, 10 mm seam allowance"))
+    pattern.to_dxf(out / "cup_astm.dxf", profile="astm", seam_allowance=10.0)
+    written.append((out / "cup_astm.dxf", "the same for garment CAD (ASTM D6673)"))
+    report.to_json(out / "cup.json")
+    written.append((out / "cup.json", "report: strain per panel, seam lengths on both sides, findings"))
+    pattern.heat_map(out / "cup_heatmap.png")
+    written.append((out / "cup_heatmap.png", "strain heat map"))
+    preview_dxf(out / "cup.dxf", out / "cup_preview.png")
+    written.append((out / "cup_preview.png", "the DXF rendered at 1:1 (96 dpi)"))
+    _print_panels(report)
+    _verdict(report)  # shows what a strain limit of 5 % finds on a sphere cut in quarters
+    print(f"patterns demo: {len(model.panels)} panels, {len(model.seams)} seams; wrote:")
+    for path, what in written:
+        print(f"  {path}  {what}")
+    return EXIT_OK
+
+
+def _batch_one(path: str, out: str, options: dict) -> dict:
+    """Flatten one file into ``out``: a row of the batch summary.  Never raises."""
+    from types import SimpleNamespace
+
+    from .check import check
+    from .flatten import flatten
+
+    start = time.perf_counter()
+    row = {"file": Path(path).name, "panels": None, "seams": None, "strain_rms": None, "strain_max": None,
+           "status": "", "ok": False, "error": None, "seconds": None}
+    try:
+        args = SimpleNamespace(input=Path(path), max_edge=options["max_edge"], tolerance=options["tolerance"],
+                               units="mm")
+        model = _load(args)
+        pattern = flatten(model, method=options["method"], max_iterations=options["max_iterations"])
+        report = check(pattern, max_strain=options["max_strain"], max_seam_mismatch=options["max_seam_mismatch"])
+        stem = Path(out) / Path(path).stem
+        pattern.to_dxf(stem.with_suffix(".dxf"), profile=options["profile"],
+                       seam_allowance=options["seam_allowance"], version=options["dxf_version"])
+        report.to_json(stem.with_suffix(".json"))
+        row.update(panels=len(model.panels), seams=len(model.seams),
+                   strain_rms=max(p.strain_rms for p in report.panels),
+                   strain_max=max(p.strain_max for p in report.panels), ok=report.ok,
+                   status="ok" if report.ok else f"check failed: {report.findings[0].message}")
+    except PatternsError as exc:
+        row.update(status=f"error: {exc}", error=str(exc))
+    except Exception as exc:  # noqa: BLE001 - one bad file must not stop the batch
+        row.update(status=f"error: {type(exc).__name__}: {exc}", error=f"{type(exc).__name__}: {exc}")
+    row["seconds"] = time.perf_counter() - start
+    return row
+
+
+def _cmd_batch(args) -> int:
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    from .load import CAD_SUFFIXES, MESH_SUFFIXES
+
+    if not args.folder.is_dir():
+        raise InputError(f"{args.folder}: no such folder")
+    if args.jobs is not None and args.jobs < 1:
+        raise InputError(f"--jobs must be at least 1, got {args.jobs}")
+    files = sorted(p for p in args.folder.iterdir() if p.is_file() and p.suffix.lower() in CAD_SUFFIXES + MESH_SUFFIXES)
+    if not files:
+        raise InputError(f"{args.folder}: no CAD or mesh files in this folder")
+    try:
+        args.output.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"{args.output}: cannot create the output folder ({exc.strerror})") from None
+    options = {k: getattr(args, k) for k in ("max_edge", "tolerance", "method", "max_iterations", "max_strain",
+                                              "max_seam_mismatch", "profile", "seam_allowance", "dxf_version")}
+    progress = Progress(f"batch of {len(files)} files")
+    rows = []
+    if args.scheduler:
+        try:
+            from distributed import Client, as_completed as dask_completed
+        except ImportError:
+            raise InputError("--scheduler needs Dask: pip install 'patterns[dask]'") from None
+        try:
+            client = Client(args.scheduler, timeout="20s")
+        except (OSError, TimeoutError) as exc:
+            raise InputError(f"{args.scheduler}: cannot reach the Dask scheduler ({exc})") from None
+        with client:
+            futures = [client.submit(_batch_one, str(p), str(args.output), options, pure=False) for p in files]
+            for future in dask_completed(futures):
+                rows.append(future.result())
+                progress(len(rows), len(files))
+        where = f"Dask scheduler {args.scheduler}"
+    else:
+        jobs = args.jobs or os.cpu_count() or 1
+        with ProcessPoolExecutor(max_workers=min(jobs, len(files))) as pool:
+            futures = [pool.submit(_batch_one, str(p), str(args.output), options) for p in files]
+            for future in as_completed(futures):
+                rows.append(future.result())
+                progress(len(rows), len(files))
+        where = f"{min(jobs, len(files))} processes"
+    progress.close()
+    rows.sort(key=lambda r: r["file"])
+    table = [("file", "panels", "seams", "strain RMS %", "max %", "seconds", "status")]
+    for r in rows:
+        table.append((r["file"], "-" if r["panels"] is None else str(r["panels"]),
+                      "-" if r["seams"] is None else str(r["seams"]),
+                      "-" if r["strain_rms"] is None else f"{100 * r['strain_rms']:.2f}",
+                      "-" if r["strain_max"] is None else f"{100 * r['strain_max']:.2f}",
+                      f"{r['seconds']:.1f}", r["status"]))
+    _table(table)
+    errors = [r for r in rows if r["error"]]
+    failed = [r for r in rows if not r["error"] and not r["ok"]]
+    print(f"batch: {len(rows) - len(errors)} results, {len(errors)} failed, {len(failed)} failing a check "
+          f"({where}); wrote {args.output}")
+    if errors:
+        return EXIT_INPUT
+    return EXIT_CHECK if failed else EXIT_OK
+
+
+COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "demo": _cmd_demo,
+            "batch": _cmd_batch}
 
 
 def main(argv=None) -> int:
@@ -77,12 +420,12 @@ def main(argv=None) -> int:
     debug = "--debug" in argv
     try:
         args = _parser().parse_args(argv)
-        return _flatten(args)
+        return COMMANDS[args.command](args)
     except PatternsError as exc:
         if debug:
             raise
         print(f"patterns: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_INPUT
     except KeyboardInterrupt:  # pragma: no cover
         return 130
 

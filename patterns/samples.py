@@ -1,0 +1,85 @@
+"""The bundled sample parts, built with build123d (millimetres).
+
+Each function returns a build123d shape; :data:`SAMPLES` maps the STEP file
+names in ``samples/`` to them (``samples/make_cad.py`` writes those files, and
+``patterns demo`` builds the cup from here).
+
+* ``duct_transition`` -- square-to-round duct transition: a 400 x 400 mm square
+  at z = 0 to a 300 mm circle at z = 300, lofted with straight rulings (four
+  ruled faces, one per side of the square, each ending on a quarter circle).
+* ``hopper`` -- cone-frustum hopper: 600 mm across at the top, 200 mm at the
+  bottom, 400 mm high; one conical face closed by its seam line.
+* ``cup`` -- four-panel cup (garment): a hemisphere of radius 90 mm cut into four
+  quarter panels by two vertical planes through its axis; the seams meet at
+  the apex.
+* ``hull_panel`` -- a curved boat-hull (or facade) panel, 1200 x 600 mm, doubly
+  curved: one B-spline face through a 5 x 4 grid of points.
+"""
+
+from __future__ import annotations
+
+from math import pi
+
+__all__ = ["SAMPLES", "cup", "duct_transition", "hopper", "hull_panel"]
+
+
+def duct_transition():
+    """Square 400 x 400 (z = 0) to circle 300 (z = 300), ruled loft, four faces."""
+    from build123d import CenterArc, Polyline, Shell, Wire
+
+    half = 200.0
+    square = Polyline((-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0), close=True)
+    # The circle in four arcs facing the square's sides, starting at -135 degrees
+    # like the square's first corner, so that the loft pairs side k with arc k.
+    arcs = [CenterArc((0, 0, 300), 150.0, -135.0 + 90.0 * k, 90.0) for k in range(4)]
+    return Shell.make_loft([Wire(square.edges()), Wire(arcs)], ruled=True)
+
+
+def hopper():
+    """Lateral surface of a cone frustum: radius 100 at z = 0 to radius 300 at z = 400."""
+    from build123d import Shell, Solid
+
+    cone = Solid.make_cone(100.0, 300.0, 400.0)
+    lateral = [f for f in cone.faces() if f.geom_type.name == "CONE"]
+    return Shell(lateral)
+
+
+def cup():
+    """Hemisphere of radius 90 (apex at z = -90), as four quarter faces sewn into one shell."""
+    from build123d import Shell
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_Sewing
+    from OCP.Geom import Geom_SphericalSurface
+    from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt
+
+    sphere = Geom_SphericalSurface(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 90.0)
+    sewing = BRepBuilderAPI_Sewing(1e-6)
+    for k in range(4):
+        face = BRepBuilderAPI_MakeFace(sphere, k * pi / 2, (k + 1) * pi / 2, -pi / 2, 0.0, 1e-7).Face()
+        sewing.Add(face)
+    sewing.Perform()
+    return Shell(sewing.SewedShape())
+
+
+def hull_panel():
+    """A doubly curved panel, 1200 mm long and 600 mm wide, through a 5 x 4 grid."""
+    from build123d import Face, Vector
+
+    rows = []
+    for i in range(5):
+        x = -600.0 + 300.0 * i
+        row = []
+        for j in range(4):
+            y = -300.0 + 200.0 * j
+            # Bilge curvature across, sheer along, a little twist.
+            z = 0.00035 * y * y + 0.00012 * x * x + 0.00004 * x * y
+            row.append(Vector(x, y, z))
+        rows.append(row)
+    return Face.make_surface_from_array_of_points(rows, tol=1e-4)
+
+
+SAMPLES = {
+    "duct_transition.step": duct_transition,
+    "hopper.step": hopper,
+    "cup.step": cup,
+    "hull_panel.step": hull_panel,
+}
