@@ -85,6 +85,10 @@ def _parser() -> argparse.ArgumentParser:
     def flattening(p):
         p.add_argument("--method", choices=METHODS, default="relaxed", help="flattening method (default relaxed)")
         p.add_argument("--max-iterations", type=int, default=500, help="relaxation iterations at most (default 500)")
+        p.add_argument("--thickness", type=float, default=0.0, help="sheet thickness, mm: develop the neutral surface")
+        p.add_argument("--k-factor", type=float, default=0.5, help="neutral surface from the inside, 0..1 (default 0.5)")
+        p.add_argument("--reference", choices=("inside", "outside", "mid"), default="mid",
+                       help="which skin of the sheet the model shows (default mid)")
 
     def checking(p):
         p.add_argument("--max-strain", type=float, default=None,
@@ -99,6 +103,9 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--seam-allowance", type=float, default=0.0, help="seam allowance on every edge, mm")
         p.add_argument("--dxf-version", choices=tuple(MACHINE_VERSIONS), default=None,
                        help="machine profile: DXF version (default R2000)")
+        p.add_argument("--arcs", action="store_true", help="machine profile: cut contours as arcs and lines")
+        p.add_argument("--bend-spacing", type=float, default=None,
+                       help="draw the rulings of cylinders and cones about this far apart (mm) on BEND")
 
     flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, or .obj for one panel)")
     loading(flat)
@@ -160,7 +167,8 @@ def _flatten(model, args):
 
     progress = Progress(f"flattening {len(model.panels)} panels")
     try:
-        return flatten(model, method=args.method, max_iterations=args.max_iterations, progress=progress)
+        return flatten(model, method=args.method, max_iterations=args.max_iterations, thickness=args.thickness,
+                       k_factor=args.k_factor, reference=args.reference, progress=progress)
     finally:
         progress.close()
 
@@ -226,7 +234,7 @@ def _cmd_flatten(args) -> int:
     _print_panels(report)
     if suffix == ".dxf":
         pattern.to_dxf(args.output, profile=args.profile, seam_allowance=args.seam_allowance, units=args.units,
-                       version=args.dxf_version)
+                       version=args.dxf_version, arcs=args.arcs, bend_spacing=args.bend_spacing)
         print(f"wrote {args.output} ({args.profile} profile, {args.units})")
     else:
         from .export import write_flat_obj
@@ -330,11 +338,13 @@ def _batch_one(path: str, out: str, options: dict) -> dict:
         args = SimpleNamespace(input=Path(path), max_edge=options["max_edge"], tolerance=options["tolerance"],
                                units="mm")
         model = _load(args)
-        pattern = flatten(model, method=options["method"], max_iterations=options["max_iterations"])
+        pattern = flatten(model, method=options["method"], max_iterations=options["max_iterations"],
+                          thickness=options["thickness"], k_factor=options["k_factor"], reference=options["reference"])
         report = check(pattern, max_strain=options["max_strain"], max_seam_mismatch=options["max_seam_mismatch"])
         stem = Path(out) / Path(path).stem
         pattern.to_dxf(stem.with_suffix(".dxf"), profile=options["profile"],
-                       seam_allowance=options["seam_allowance"], version=options["dxf_version"])
+                       seam_allowance=options["seam_allowance"], version=options["dxf_version"], arcs=options["arcs"],
+                       bend_spacing=options["bend_spacing"])
         report.to_json(stem.with_suffix(".json"))
         row.update(panels=len(model.panels), seams=len(model.seams),
                    strain_rms=max(p.strain_rms for p in report.panels),
@@ -365,7 +375,8 @@ def _cmd_batch(args) -> int:
     except OSError as exc:
         raise InputError(f"{args.output}: cannot create the output folder ({exc.strerror})") from None
     options = {k: getattr(args, k) for k in ("max_edge", "tolerance", "method", "max_iterations", "max_strain",
-                                              "max_seam_mismatch", "profile", "seam_allowance", "dxf_version")}
+                                              "max_seam_mismatch", "profile", "seam_allowance", "dxf_version",
+                                              "thickness", "k_factor", "reference", "arcs", "bend_spacing")}
     progress = Progress(f"batch of {len(files)} files")
     rows = []
     if args.scheduler:

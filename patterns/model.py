@@ -8,16 +8,52 @@ read-only; nothing here changes after it is made.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 import numpy as np
 
-__all__ = ["Model", "Panel", "Seam"]
+__all__ = ["Model", "Panel", "Seam", "Surface", "SurfaceKind"]
 
 
 def _readonly(a) -> np.ndarray:
     a = np.asarray(a)
     a.setflags(write=False)
     return a
+
+
+class SurfaceKind(str, Enum):
+    """The analytic surfaces a panel can be unrolled from exactly."""
+
+    PLANE = "plane"
+    CYLINDER = "cylinder"
+    CONE = "cone"
+
+
+@dataclass(frozen=True, eq=False)
+class Surface:
+    """A CAD face's analytic surface (OpenCascade's parametrisation), in mm.
+
+    Attributes
+    ----------
+    kind : SurfaceKind
+    origin, x_dir, y_dir, axis : (3,) float64
+        The surface's frame (``gp_Ax3``): location, X and Y directions, main axis.
+    radius : float
+        Cylinder: its radius; cone: the radius in the plane through ``origin``.
+    semi_angle : float
+        Cone: half the opening angle, radians (signed as in OpenCascade).
+
+    A cylinder is ``origin + radius (cos u x_dir + sin u y_dir) + v axis``; a
+    cone ``origin + (radius + v sin a)(cos u x_dir + sin u y_dir) + v cos a axis``.
+    """
+
+    kind: SurfaceKind
+    origin: np.ndarray
+    x_dir: np.ndarray
+    y_dir: np.ndarray
+    axis: np.ndarray
+    radius: float = 0.0
+    semi_angle: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -37,6 +73,12 @@ class Panel:
     cad_faces : tuple of int
         The CAD faces (indices into the shape's faces, in build123d's
         ``shape.faces()`` order) meshed into this panel; empty for a mesh file.
+    surface : Surface or None
+        For a panel that is one planar, cylindrical or conical CAD face: its
+        surface, which :func:`patterns.flatten` unrolls exactly.
+    param : (n, 2) float64 or None
+        With ``surface``: each vertex's surface parameters (u, v), to tell the
+        two copies of a point on a seam line apart (approximate on the boundary).
     """
 
     name: str
@@ -44,11 +86,15 @@ class Panel:
     faces: np.ndarray
     loops: tuple
     cad_faces: tuple = ()
+    surface: Surface | None = None
+    param: np.ndarray | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "vertices", _readonly(self.vertices))
         object.__setattr__(self, "faces", _readonly(self.faces))
         object.__setattr__(self, "loops", tuple(_readonly(loop) for loop in self.loops))
+        if self.param is not None:
+            object.__setattr__(self, "param", _readonly(np.array(self.param, dtype=np.float64)))
 
     @property
     def area(self) -> float:

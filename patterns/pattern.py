@@ -41,15 +41,87 @@ class FlatPanel:
         angle, dx, dy = self.placement
         if angle == 0.0 and dx == 0.0 and dy == 0.0:
             return self.flattening.uv
-        c, s = np.cos(angle), np.sin(angle)
-        uv = self.flattening.uv @ np.array([[c, s], [-s, c]]) + np.array([dx, dy])
+        uv = self.place(self.flattening.uv)
         uv.setflags(write=False)
         return uv
 
+    def place(self, points) -> np.ndarray:
+        """Points of the flattening's own frame, (k, 2) mm, moved by the panel's placement."""
+        angle, dx, dy = self.placement
+        c, s = np.cos(angle), np.sin(angle)
+        return np.asarray(points, dtype=np.float64) @ np.array([[c, s], [-s, c]]) + np.array([dx, dy])
+
+    def rulings(self, spacing: float) -> list:
+        """Straight rulings of an exactly developed cylinder or cone, about ``spacing`` mm apart.
+
+        The lines a press brake bumps or a roll follows: on a cylinder parallel
+        to its axis, on a cone through its apex.  Spaced evenly in angle so that
+        neighbours are ``spacing`` apart along the longest edge, the outline's
+        own edges excluded.
+
+        Returns
+        -------
+        list of ((2,) float64, (2,) float64, float)
+            Each line's two ends in the flat pattern as placed (mm, clipped to
+            the panel) and the bend angle it carries: the turn about the axis
+            between neighbouring rulings, degrees.  Empty for any other panel.
+        """
+        import shapely
+
+        from .model import SurfaceKind
+
+        surface = self.panel.surface
+        if self.flattening.method != "exact" or surface is None or surface.kind is SurfaceKind.PLANE:
+            return []
+        if not (isinstance(spacing, (int, float)) and spacing > 0):
+            from .errors import InputError
+
+            raise InputError(f"panel {self.name}: ruling spacing must be a positive number of mm, got {spacing!r}")
+        uv = self.flattening.uv
+        polygon = shapely.Polygon(uv[self.loops[0]], [uv[lp] for lp in self.loops[1:]])
+        size = float(np.ptp(uv, axis=0).max()) * 4 + 1.0
+        lines = []
+        if surface.kind is SurfaceKind.CYLINDER:
+            x0, x1 = uv[:, 0].min(), uv[:, 0].max()
+            n = max(int(round((x1 - x0) / spacing)), 1)
+            step = (x1 - x0) / n
+            turn = np.degrees(step / self._radius())
+            for k in range(1, n):
+                x = x0 + k * step
+                lines.append((shapely.LineString([(x, -size), (x, size)]), turn))
+        else:
+            r = np.hypot(uv[:, 0], uv[:, 1])
+            theta = np.unwrap(np.arctan2(uv[self.loops[0], 1], uv[self.loops[0], 0]))
+            t0, t1 = theta.min(), theta.max()
+            n = max(int(round((t1 - t0) * r.max() / spacing)), 1)
+            step = (t1 - t0) / n
+            turn = np.degrees(step / abs(np.sin(surface.semi_angle)))
+            for k in range(1, n):
+                t = t0 + k * step
+                lines.append((shapely.LineString([(0.0, 0.0), (size * np.cos(t), size * np.sin(t))]), turn))
+        out = []
+        for line, turn in lines:
+            part = line.intersection(polygon)
+            for seg in getattr(part, "geoms", [part]):
+                if seg.is_empty or seg.length <= 0:
+                    continue
+                a, b = np.asarray(seg.coords)[[0, -1]]
+                a, b = self.place([a, b])
+                out.append((a, b, float(turn)))
+        return out
+
+    def _radius(self) -> float:
+        """A cylinder panel's developed radius (of the neutral surface)."""
+        s = self.panel.surface
+        rel = self.vertices - s.origin
+        radial = rel - np.outer(rel @ s.axis, s.axis)
+        return float(np.median(np.linalg.norm(radial, axis=1)))
+
     @property
     def vertices(self) -> np.ndarray:
-        """(n, 3) float64, mm: the 3D vertices."""
-        return self.panel.vertices
+        """(n, 3) float64, mm: the 3D surface that was laid flat -- the panel's
+        vertices, or with a sheet thickness their neutral-surface offset."""
+        return self.flattening.vertices
 
     @property
     def faces(self) -> np.ndarray:
@@ -119,6 +191,9 @@ class Pattern:
     panels: tuple
     seams: tuple
     method: str
+    thickness: float = 0.0
+    k_factor: float = 0.5
+    reference: str = "mid"
     laid_out: bool = False
     """True once the panels have been placed on a sheet (:meth:`placed`): only
     then are panels checked against each other."""
@@ -134,7 +209,8 @@ class Pattern:
 
     def to_dxf(self, path, *, profile: str = "machine", seam_allowance=0.0, units: str = "mm",
                version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
-               gap: float | None = None) -> None:
+               gap: float | None = None, arcs: bool = False, arc_tolerance: float = 0.01,
+               bend_spacing: float | None = None) -> None:
         """Write the pattern as a DXF file for a cutter (atomically).
 
         Parameters
@@ -161,11 +237,20 @@ class Pattern:
             mm; default 3 % of each panel's size, 2-12 mm.
         gap : float, optional
             Space between panels when the pattern is not laid out, mm.
+        arcs : bool
+            Machine profile: write each cut contour with arcs and lines fitted
+            within ``arc_tolerance`` (one closed polyline with bulges).
+        arc_tolerance : float
+            mm (default 0.01).
+        bend_spacing : float, optional
+            Draw the rulings of exactly developed cylinders and cones about this
+            far apart (mm) on BEND with their bend angles (ASTM: layer 8).
         """
         from .export.dxf import write_pattern_dxf
 
         write_pattern_dxf(self, path, profile=profile, seam_allowance=seam_allowance, units=units, version=version,
-                          strain_layer=strain_layer, text_height=text_height, gap=gap)
+                          strain_layer=strain_layer, text_height=text_height, gap=gap, arcs=arcs,
+                          arc_tolerance=arc_tolerance, bend_spacing=bend_spacing)
 
     def heat_map(self, path, **options) -> None:
         """Write the strain heat map (PNG or SVG); see :func:`patterns.heat_map`."""

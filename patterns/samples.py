@@ -14,13 +14,16 @@ names in ``samples/`` to them (``samples/make_cad.py`` writes those files, and
   the apex.
 * ``hull_panel`` -- a curved boat-hull (or facade) panel, 1200 x 600 mm, doubly
   curved: one B-spline face through a 5 x 4 grid of points.
+* ``rolled_cylinder`` -- a rolled shell, 500 mm across and 500 mm high: one
+  cylindrical face closed by its seam line (sheet metal: its blank is a
+  rectangle, 2 pi times the neutral radius long).
 """
 
 from __future__ import annotations
 
 from math import pi
 
-__all__ = ["SAMPLES", "cup", "duct_transition", "hopper", "hull_panel"]
+__all__ = ["SAMPLES", "cup", "duct_transition", "hopper", "hull_panel", "rolled_cylinder"]
 
 
 def duct_transition():
@@ -77,9 +80,18 @@ def hull_panel():
     return Face.make_surface_from_array_of_points(rows, tol=1e-4)
 
 
+def rolled_cylinder():
+    """Lateral surface of a cylinder: radius 250, height 500 (the inside skin of a rolled shell)."""
+    from build123d import Shell, Solid
+
+    cylinder = Solid.make_cylinder(250.0, 500.0)
+    return Shell([f for f in cylinder.faces() if f.geom_type.name == "CYLINDER"])
+
+
 SAMPLES = {
     "duct_transition.step": duct_transition,
     "hopper.step": hopper,
     "cup.step": cup,
     "hull_panel.step": hull_panel,
+    "rolled_cylinder.step": rolled_cylinder,
 }

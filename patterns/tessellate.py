@@ -612,6 +612,9 @@ class _ShapeMesher:
         tri[area2 < 0] = tri[area2 < 0][:, [0, 2, 1]]
         centre = p.mean(axis=1)
         keep = shapely.contains_xy(polygon, centre[:, 0], centre[:, 1]) & (np.abs(area2) > 1e-12 * h * h)
+        # A sliver across three boundary points on a straight boundary (a seam
+        # line) has its centre on the boundary itself: it is not inside.
+        keep &= ~(np.all(tri < len(xy_b), axis=1) & (np.abs(area2) < 1e-6 * h * h))
         tri = tri[keep]
         # Every boundary segment must be an edge of a kept triangle.
         n_pts = len(points)
@@ -640,7 +643,8 @@ class _ShapeMesher:
         tri = _flip_to_delaunay(np.concatenate([xyz_b, xyz_in]), np.concatenate([uv_b, uv_in]), tri, fixed)
         if face.Orientation() == TopAbs_REVERSED:
             tri = tri[:, [0, 2, 1]]
-        return _FaceMesh(np.asarray(slot_gid, dtype=np.int64), xyz_in, tri, occurrences, occ_slots)
+        return _FaceMesh(np.asarray(slot_gid, dtype=np.int64), xyz_in, tri, occurrences, occ_slots,
+                         np.concatenate([uv_b, uv_in]))
 
     # -- panels and seams ----------------------------------------------------
     def _assemble(self, groups, meshes):
@@ -693,7 +697,13 @@ class _ShapeMesher:
             v, f, conn = validate_mesh(vertices, faces, name=pname)
             loops = sorted(conn.loops, key=lambda lp: -np.linalg.norm(
                 v[np.roll(lp, -1)] - v[lp], axis=1).sum())
-            panels.append(Panel(label, v, f, tuple(loops), tuple(members)))
+            surface = param = None
+            if len(members) == 1:
+                k = members[0]
+                surface = surface_of(self.surfaces[k], self.faces[k])
+                if surface is not None:
+                    param = meshes[k].param[fv[first[order]] - offsets[k]]
+            panels.append(Panel(label, v, f, tuple(loops), tuple(members), surface=surface, param=param))
             local_of.append(local)
         seams = []
         for e, occ in enumerate(occ_of_edge):
@@ -714,11 +724,40 @@ class _ShapeMesher:
         return panels, seams
 
 
+def surface_of(surface, face):
+    """The analytic surface of a face, when it is a plane, a cylinder or a cone; else None."""
+    from OCP.GeomAbs import GeomAbs_Cone, GeomAbs_Cylinder, GeomAbs_Plane
+
+    from .model import Surface, SurfaceKind
+
+    kind = surface.GetType()
+    if kind == GeomAbs_Plane:
+        ax, extra = surface.Plane().Position(), {}
+        kind = SurfaceKind.PLANE
+    elif kind == GeomAbs_Cylinder:
+        cyl = surface.Cylinder()
+        ax, extra = cyl.Position(), {"radius": cyl.Radius()}
+        kind = SurfaceKind.CYLINDER
+    elif kind == GeomAbs_Cone:
+        cone = surface.Cone()
+        ax, extra = cone.Position(), {"radius": cone.RefRadius(), "semi_angle": cone.SemiAngle()}
+        kind = SurfaceKind.CONE
+    else:
+        return None
+
+    def vec(d):
+        return np.array([d.X(), d.Y(), d.Z()])
+
+    return Surface(kind=kind, origin=vec(ax.Location()), x_dir=vec(ax.XDirection()), y_dir=vec(ax.YDirection()),
+                   axis=vec(ax.Direction()), **extra)
+
+
 class _FaceMesh:
     """One face's mesh before assembly: boundary slots (global points) then interior points."""
 
-    def __init__(self, slot_gid, interior, triangles, occurrences, occ_slots):
+    def __init__(self, slot_gid, interior, triangles, occurrences, occ_slots, param=None):
         self.slot_gid = slot_gid
+        self.param = param  # (slots + interior, 2) surface parameters (boundary ones approximate)
         self.interior = interior
         self.triangles = triangles
         self.occurrences = occurrences

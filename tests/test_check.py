@@ -48,7 +48,8 @@ def test_developable_sample_has_no_strain_and_no_mismatch(hopper):
     assert report.ok and report.findings == ()
     (panel,) = report.panels
     assert panel.strain_max < 1e-3 and panel.strain_rms < 1e-4
-    assert panel.area_flat == pytest.approx(panel.area_3d, rel=1e-6)
+    # Exact development: the flat area is the true one, the 3D triangles (chords) a hair smaller.
+    assert panel.area_flat == pytest.approx(panel.area_3d, rel=1e-4)
     (seam,) = report.seams
     assert seam.panels == ("face0", "face0") and seam.cad_edge is not None
     assert abs(seam.mismatch) < 1e-3 and abs(seam.mismatch_percent) < 1e-4  # measured 1.1e-4 mm on 447 mm

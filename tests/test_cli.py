@@ -258,3 +258,16 @@ def test_progress_bar_only_on_a_terminal(capsys):
     bar(10, 10)
     assert "work [###############---------------]  50%" in stream.getvalue()
     assert stream.getvalue().endswith("100%\n")
+
+
+def test_sheet_metal_options(tmp_path):
+    out = tmp_path / "shell.dxf"
+    proc = run("flatten", SAMPLES / "rolled_cylinder.step", "-o", out, "--thickness", "2", "--k-factor", "0.44",
+               "--reference", "inside", "--arcs", "--bend-spacing", "100")
+    assert proc.returncode == 0, proc.stderr
+    doc, auditor = recover.readfile(out)
+    assert not auditor.has_errors
+    (cut,) = doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')
+    xs = [p[0] for p in cut.get_points("xy")]
+    assert max(xs) - min(xs) == pytest.approx(2 * np.pi * (250 + 0.88), abs=0.01)
+    assert len(doc.modelspace().query('LINE[layer=="BEND"]')) == 15

@@ -122,8 +122,11 @@ class _PanelGeometry:
         self.text_height = text_height if text_height else float(np.clip(0.03 * box.max(), 2.0, 12.0))
         from ..measure import strain_summary, triangle_strains
 
-        # The same numbers as patterns.check's report.
-        self.strain_rms, self.strain_max, _ = strain_summary(triangle_strains(flat.vertices, flat.faces, flat.uv))
+        # The same numbers as patterns.check's report (an exact development has no strain).
+        if flat.flattening.method == "exact":
+            self.strain_rms = self.strain_max = 0.0
+        else:
+            self.strain_rms, self.strain_max, _ = strain_summary(triangle_strains(flat.vertices, flat.faces, flat.uv))
         self.box = np.r_[uv.min(axis=0), uv.max(axis=0)]
 
 
@@ -269,7 +272,8 @@ def _notches(pattern, geo, allowance_of):
 
 def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance=0.0, units: str = "mm",
                       version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
-                      gap: float | None = None) -> None:
+                      gap: float | None = None, arcs: bool = False, arc_tolerance: float = 0.01,
+                      bend_spacing: float | None = None) -> None:
     """Write a whole pattern as a DXF for cutters.
 
     See :meth:`patterns.Pattern.to_dxf` and docs/dxf.md for the two profiles.
@@ -293,19 +297,27 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
         raise InputError(f"{path}: unknown DXF version {version!r}; choose one of {', '.join(MACHINE_VERSIONS)}")
     if text_height is not None and not (isinstance(text_height, (int, float)) and text_height > 0):
         raise InputError(f"{path}: text_height must be a positive number of mm, got {text_height!r}")
+    if not isinstance(arc_tolerance, (int, float)) or isinstance(arc_tolerance, bool) or not arc_tolerance > 0:
+        raise InputError(f"{path}: arc_tolerance must be a positive number of mm, got {arc_tolerance!r}")
+    if bend_spacing is not None and (isinstance(bend_spacing, bool) or not isinstance(bend_spacing, (int, float))
+                                     or not bend_spacing > 0):
+        raise InputError(f"{path}: bend_spacing must be a positive number of mm, got {bend_spacing!r}")
+    if arcs and profile != "machine":
+        raise InputError(f"{path}: arcs are written in the machine profile only")
     allowance_of = _allowance_lookup(seam_allowance, {s.seam.id for s in pattern.seams}, path)
     scale = {"mm": 1.0, "cm": 0.1, "m": 0.001, "in": 1 / 25.4}[units]
     biggest = max(float(np.max(_allowance_values(pattern, allowance_of))), 0.0)
     offsets = display_offsets(pattern, gap=gap if gap is not None else None, margin=biggest)
     geos = [_PanelGeometry(pattern, i, offsets[i], allowance_of, text_height) for i in range(len(pattern.panels))]
     if profile == "machine":
-        doc = _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer)
+        doc = _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer,
+                           arc_tolerance if arcs else None, bend_spacing, offsets)
         with atomic_output(path, what="DXF file") as tmp:
             doc.saveas(tmp)
     else:
         from ezdxf.addons import gerber_D6673
 
-        doc = _astm_doc(ezdxf, pattern, geos, allowance_of)
+        doc = _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets)
         with atomic_output(path, what="DXF file") as tmp:
             gerber_D6673.export_file(doc, tmp)
 
@@ -314,7 +326,8 @@ def _allowance_values(pattern, allowance_of):
     return [allowance_of(None)] + [allowance_of(s.seam.id) for s in pattern.seams]
 
 
-def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer):
+def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer, arc_tolerance,
+                 bend_spacing, offsets):
     r12 = version == "R12"
     doc = _new_doc(ezdxf, version, 0 if r12 else UNITS[units])
     if not r12:
@@ -326,6 +339,19 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, stra
     msp = doc.modelspace()
 
     def poly(points, layer, close=True):
+        if arc_tolerance is not None and layer == "CUT":
+            from .arcs import fit_arcs
+
+            fitted = fit_arcs(np.asarray(points), arc_tolerance)
+            fitted[:, :2] *= scale
+            if r12:
+                msp.add_polyline2d(fitted[:, :2].tolist(), close=True, dxfattribs={"layer": layer})
+                entity = msp[-1]
+                for vertex, bulge in zip(entity.vertices, fitted[:, 2]):
+                    vertex.dxf.bulge = float(bulge)
+            else:
+                msp.add_lwpolyline(fitted.tolist(), format="xyb", close=True, dxfattribs={"layer": layer})
+            return
         pts = (np.asarray(points) * scale).tolist()
         if r12:
             msp.add_polyline2d(pts, close=close, dxfattribs={"layer": layer})
@@ -353,6 +379,13 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, stra
              g.label_at - [0.0, 0.9 * g.text_height], 0.7 * g.text_height)
         for s, at, angle in _seam_annotations(pattern, g):
             text(s, at, 0.6 * g.text_height, angle)
+        if bend_spacing is not None:
+            for a, b, turn in pattern.panels[g.index].rulings(bend_spacing):
+                a, b = a + offsets[g.index], b + offsets[g.index]
+                msp.add_line(tuple(a * scale), tuple(b * scale), dxfattribs={"layer": "BEND"})
+                direction = (b - a) / max(np.linalg.norm(b - a), 1e-12)
+                text(f"BEND {turn:.2f} DEG", b - direction * 2.0 * g.text_height, 0.5 * g.text_height,
+                     _readable_angle(direction), layer="BEND")
         if strain_layer:
             _strain_solids(msp, pattern.panels[g.index], g.uv, scale, truecolor=version not in ("R12", "R2000"))
     if r12:
@@ -415,7 +448,7 @@ def _strain_solids(msp, flat, uv, scale, truecolor):
         msp.add_solid([tuple(p[0]), tuple(p[1]), tuple(p[2])], dxfattribs=attribs)
 
 
-def _astm_doc(ezdxf, pattern, geos, allowance_of):
+def _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets):
     """ASTM D6673 (AAMA) R12 document: one block per piece, inserted on layer 1."""
     doc = _new_doc(ezdxf, "R12", 0)
     for layer in ASTM_LAYERS:
@@ -444,6 +477,9 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of):
             block.add_point((float(base[0]), float(base[1]), float(depth)),
                             dxfattribs={"layer": "4", "angle": angle})
         block.add_line(*_grain_line(g), dxfattribs={"layer": "7"})
+        if bend_spacing is not None:  # internal lines (layer 8): the rulings of a rolled panel
+            for a, b, _ in pattern.panels[g.index].rulings(bend_spacing):
+                block.add_line(tuple(a + offsets[g.index]), tuple(b + offsets[g.index]), dxfattribs={"layer": "8"})
         th = g.text_height
         lines = [f"Piece Name:{g.name}", "Quantity:1", "Material:", f"Style Name:{pattern.name}", "Units:METRIC"]
         for k, s in enumerate(lines):

@@ -237,8 +237,8 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
     )
 
 
-def flatten(model, *, method: str = "relaxed", max_iterations: int = 500, tolerance: float = 1e-4,
-            progress=None):
+def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: float = 0.0, k_factor: float = 0.5,
+            reference: str = "mid", max_iterations: int = 500, tolerance: float = 1e-4, progress=None):
     """Lay every panel of a model flat at true scale.
 
     Parameters
@@ -246,7 +246,22 @@ def flatten(model, *, method: str = "relaxed", max_iterations: int = 500, tolera
     model : patterns.Model
         From :func:`patterns.load`.
     method : {"relaxed", "isometric", "conformal"}
-        See :func:`flatten_mesh`.
+        The mesh engine, for freeform panels (see :func:`flatten_mesh`).
+    exact : bool
+        Unroll planar, cylindrical and conical CAD faces analytically
+        (:mod:`patterns.flatten.develop`: exact to round-off, no mesh engine);
+        their :attr:`Flattening.method` is ``"exact"``.  False sends them
+        through the engine too.
+    thickness : float
+        Sheet thickness, mm (>= 0).  With a thickness the pattern is the
+        development of the neutral surface, ``k_factor * thickness`` from the
+        inside skin, so that the blank forms to the modelled size.
+    k_factor : float
+        Position of the neutral surface in the sheet, from the inside (0..1).
+    reference : {"inside", "outside", "mid"}
+        Which skin the model shows.  The offset goes towards the convex side of
+        cylinders and cones (away from their axis), along the face normal on
+        freeform faces.
     max_iterations, tolerance
         ``"relaxed"`` only; see :func:`flatten_mesh`.
     progress : callable, optional
@@ -267,13 +282,22 @@ def flatten(model, *, method: str = "relaxed", max_iterations: int = 500, tolera
     """
     from ..model import Model
     from ..pattern import FlatPanel, FlatSeam, Pattern
+    from .develop import neutral_offset
 
     if not isinstance(model, Model):
         raise InputError(f"flatten() takes a patterns.Model (from patterns.load), got {type(model).__name__}")
+    if method not in METHODS:
+        raise InputError(f"unknown flattening method {method!r}; choose one of {', '.join(METHODS)}")
+    offset = neutral_offset(thickness, k_factor, reference, name=model.name)
     flat = []
     for i, panel in enumerate(model.panels):
-        result = flatten_mesh(panel.vertices, panel.faces, method=method, max_iterations=max_iterations,
-                              tolerance=tolerance, name=f"{model.name}: panel {panel.name}")
+        name = f"{model.name}: panel {panel.name}"
+        if exact and panel.surface is not None:
+            result = _developed(panel, offset, name)
+        else:
+            vertices = _offset_along_normals(panel, offset) if offset else panel.vertices
+            result = flatten_mesh(vertices, panel.faces, method=method, max_iterations=max_iterations,
+                                  tolerance=tolerance, name=name)
         flat.append(FlatPanel(panel.name, panel, result))
         if progress is not None:
             progress(i + 1, len(model.panels))
@@ -284,4 +308,31 @@ def flatten(model, *, method: str = "relaxed", max_iterations: int = 500, tolera
             for p, idx in zip(seam.panels, seam.vertices)
         )
         seams.append(FlatSeam(seam, lengths))
-    return Pattern(model=model, panels=tuple(flat), seams=tuple(seams), method=method)
+    return Pattern(model=model, panels=tuple(flat), seams=tuple(seams), method=method,
+                   thickness=float(thickness), k_factor=float(k_factor), reference=reference)
+
+
+def _developed(panel, offset: float, name: str) -> Flattening:
+    """The exact development of a planar, cylindrical or conical panel (of its offset by ``offset``)."""
+    from .develop import develop, offset_points
+
+    vertices = offset_points(panel.surface, panel.vertices, offset)
+    uv = develop(panel.surface, vertices, panel.param, offset=offset)
+    if np.sum(signed_areas(panel.faces, uv)) < 0:
+        uv[:, 0] = -uv[:, 0]  # the parametrisation runs the other way round: mirror (an isometry)
+    if not np.all(np.isfinite(uv)):
+        raise FlattenError(f"{name}: the exact development gave non-finite coordinates")
+    v, f, conn = validate_mesh(vertices, panel.faces, name=name)
+    return Flattening(uv=_readonly(uv), vertices=_readonly(v), faces=_readonly(f), loops=conn.loops,
+                      method="exact", seed_face=-1, overlap=overlap_verdict(f, uv, conn.loops), start="analytic")
+
+
+def _offset_along_normals(panel, offset: float) -> np.ndarray:
+    """Panel vertices moved by ``offset`` along their area-weighted normals (freeform sheet thickness)."""
+    v, f = panel.vertices, panel.faces
+    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])  # length = 2 x area: area-weighted
+    vn = np.zeros_like(v)
+    for k in range(3):
+        np.add.at(vn, f[:, k], n)
+    vn /= np.maximum(np.linalg.norm(vn, axis=1, keepdims=True), 1e-300)
+    return v + offset * vn

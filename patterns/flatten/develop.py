@@ -1,0 +1,127 @@
+"""Exact unrolling of planes, cylinders and cones, and the neutral surface of a sheet.
+
+A plane, a cylinder and a cone are developable: each point has exact flat
+coordinates, computed here from its 3D position, with no mesh engine and no
+error beyond round-off.
+
+* plane: coordinates in the plane's own frame;
+* cylinder of radius ``R``: ``(R u, v)``, ``u`` the angle around the axis and
+  ``v`` the height along it;
+* cone with apex ``A`` and half-angle ``a``: polar coordinates ``(s, u sin a)``,
+  ``s`` the distance from the apex along the generator.
+
+Sheet thickness: the blank is cut so that the *neutral* surface -- the one that
+neither stretches nor shrinks when the sheet is bent, at ``k t`` from the inside
+skin (``k`` the K-factor, ``t`` the thickness) -- has the modelled size.  Its
+offset from the modelled skin, :func:`neutral_offset`, is measured towards the
+convex side (away from the axis of a cylinder or cone).  A plane's development
+does not change with an offset; a cylinder's radius becomes ``R + d``; a cone
+keeps its axis and angle and its apex moves along the axis.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from ..model import SurfaceKind
+
+__all__ = ["REFERENCES", "develop", "neutral_offset", "offset_points"]
+
+REFERENCES = ("inside", "outside", "mid")
+"""Which skin of the sheet the CAD model shows."""
+
+
+def neutral_offset(thickness: float, k_factor: float, reference: str, *, name: str = "pattern") -> float:
+    """Signed distance from the modelled skin to the neutral surface, mm (positive: convex side).
+
+    Parameters
+    ----------
+    thickness : float
+        Sheet thickness, mm (>= 0).
+    k_factor : float
+        Position of the neutral surface from the inside skin, as a fraction of
+        the thickness (0 <= k <= 1; 0.5 is the middle).
+    reference : {"inside", "outside", "mid"}
+        The skin the model shows: the inside of the bends, the outside, or the
+        middle of the sheet.
+    """
+    if isinstance(thickness, bool) or not isinstance(thickness, (int, float)) or not np.isfinite(thickness) \
+            or thickness < 0:
+        raise InputError(f"{name}: thickness must be a number >= 0 mm, got {thickness!r}")
+    if isinstance(k_factor, bool) or not isinstance(k_factor, (int, float)) or not 0 <= k_factor <= 1:
+        raise InputError(f"{name}: k_factor must be a number in [0, 1], got {k_factor!r}")
+    if reference not in REFERENCES:
+        raise InputError(f"{name}: reference must be one of {', '.join(REFERENCES)}, got {reference!r}")
+    inside = {"inside": 0.0, "outside": -thickness, "mid": -0.5 * thickness}[reference]
+    return float(inside + k_factor * thickness)
+
+
+def _radial(surface, points):
+    """Axial height, radial distance and angle of points about the surface's axis."""
+    rel = points - surface.origin
+    x, y = rel @ surface.x_dir, rel @ surface.y_dir
+    return rel @ surface.axis, np.hypot(x, y), np.arctan2(y, x)
+
+
+def offset_points(surface, points: np.ndarray, offset: float) -> np.ndarray:
+    """Move points on an analytic surface by ``offset`` along its normal (towards the convex side)."""
+    if offset == 0.0 or surface.kind is SurfaceKind.PLANE:
+        return np.array(points, dtype=np.float64)
+    rel = points - surface.origin
+    h = rel @ surface.axis
+    radial = rel - np.outer(h, surface.axis)
+    r = np.linalg.norm(radial, axis=1, keepdims=True)
+    out_dir = radial / np.maximum(r, 1e-300)
+    if surface.kind is SurfaceKind.CYLINDER:
+        normal = out_dir
+    else:
+        a = surface.semi_angle  # the generator climbs by cos a along the axis for sin a outwards
+        normal = out_dir * np.cos(a) - np.outer(np.full(len(points), np.sin(a)), surface.axis)
+        normal *= np.sign(np.cos(a))
+    return points + offset * normal
+
+
+def develop(surface, points: np.ndarray, param: np.ndarray | None = None, *, offset: float = 0.0) -> np.ndarray:
+    """Exact flat coordinates of points on a plane, cylinder or cone.
+
+    Parameters
+    ----------
+    surface : patterns.Surface
+    points : (n, 3) float64, mm
+        On the surface (or on its offset by :func:`offset_points`: the same
+        formulas hold for the offset cylinder and cone).
+    param : (n, 2) float64, optional
+        Approximate surface parameters, to pick the right turn of the angle
+        ``u`` for points that appear twice (both sides of a seam line).
+    offset : float
+        The points lie on the surface offset by this much (mm, towards the
+        convex side): a cone's apex then moves along its axis.
+
+    Returns
+    -------
+    (n, 2) float64, mm
+        Counter-clockwise as the surface's parametrisation is; the caller
+        mirrors if its triangles come out clockwise.
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if surface.kind is SurfaceKind.PLANE:
+        rel = points - surface.origin
+        return np.column_stack([rel @ surface.x_dir, rel @ surface.y_dir])
+    h, r, angle = _radial(surface, points)
+    if param is not None:
+        # The same 3D point on both sides of a seam: atan2 cannot tell; the
+        # parameter says which turn it is on.
+        angle = angle + 2 * np.pi * np.round((param[:, 0] - angle) / (2 * np.pi))
+    else:
+        angle = np.unwrap(angle)
+    if surface.kind is SurfaceKind.CYLINDER:
+        return np.column_stack([np.median(r) * angle, h])  # the radius is the same for all, to round-off
+    a = surface.semi_angle
+    sin_a = np.sin(a)
+    # Apex: where the radius vanishes (radius + v sin a = 0, at height v cos a);
+    # the offset cone's apex lies offset / sin a lower along the axis.
+    apex_h = -surface.radius / np.tan(a) - offset / sin_a
+    s = np.hypot(r, h - apex_h)
+    theta = angle * abs(sin_a)
+    return np.column_stack([s * np.cos(theta), s * np.sin(theta)])
