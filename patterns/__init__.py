@@ -18,12 +18,14 @@ from .errors import (
     ExportError,
     FlattenError,
     InputError,
+    LayoutError,
     MeshTopologyError,
     PatternsError,
 )
 from .cut import Cut, cut_to_disk
 from .export import heat_map, preview_dxf
 from .flatten import METHODS, Flattening, flatten, flatten_mesh
+from .layout import Layout, layout
 from .load import load, read_cad, read_mesh
 from .measure import Distortion, distortion
 from .mesh import Connectivity, validate_mesh
@@ -46,6 +48,8 @@ __all__ = [
     "FlatSeam",
     "Flattening",
     "InputError",
+    "Layout",
+    "LayoutError",
     "MeshTopologyError",
     "Model",
     "Overlap",
@@ -61,6 +65,7 @@ __all__ = [
     "flatten",
     "flatten_mesh",
     "heat_map",
+    "layout",
     "load",
     "mesh_shape",
     "overlap_verdict",

@@ -63,6 +63,16 @@ class Progress:
             self.stream.flush()
 
 
+def _direction(text: str):
+    try:
+        values = [float(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected X,Y,Z numbers, got {text!r}") from None
+    if len(values) != 3:
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}")
+    return tuple(values)
+
+
 def _parser() -> argparse.ArgumentParser:
     from . import METHODS, __version__
     from .export.dxf import MACHINE_VERSIONS, PROFILES, UNITS
@@ -89,6 +99,8 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--k-factor", type=float, default=0.5, help="neutral surface from the inside, 0..1 (default 0.5)")
         p.add_argument("--reference", choices=("inside", "outside", "mid"), default="mid",
                        help="which skin of the sheet the model shows (default mid)")
+        p.add_argument("--grain", type=_direction, default=None, metavar="X,Y,Z",
+                       help="3D direction to point along +Y on every panel (fabric grain, rolling direction)")
 
     def checking(p):
         p.add_argument("--max-strain", type=float, default=None,
@@ -106,6 +118,10 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--arcs", action="store_true", help="machine profile: cut contours as arcs and lines")
         p.add_argument("--bend-spacing", type=float, default=None,
                        help="draw the rulings of cylinders and cones about this far apart (mm) on BEND")
+        p.add_argument("--notch-spacing", type=float, default=None,
+                       help="matching notches along every seam every this many mm of 3D length (default: ends)")
+        p.add_argument("--roll-width", type=float, default=None,
+                       help="nest the panels on a roll this wide (mm) before writing; grain kept along the roll")
 
     flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, or .obj for one panel)")
     loading(flat)
@@ -168,7 +184,7 @@ def _flatten(model, args):
     progress = Progress(f"flattening {len(model.panels)} panels")
     try:
         return flatten(model, method=args.method, max_iterations=args.max_iterations, thickness=args.thickness,
-                       k_factor=args.k_factor, reference=args.reference, progress=progress)
+                       k_factor=args.k_factor, reference=args.reference, grain=args.grain, progress=progress)
     finally:
         progress.close()
 
@@ -230,11 +246,16 @@ def _cmd_flatten(args) -> int:
     start = time.perf_counter()
     pattern = _flatten(model, args)
     print(f"flattened ({args.method}) in {time.perf_counter() - start:.2f} s")
+    if args.roll_width is not None:
+        nest = pattern.layout(width=args.roll_width, margin=args.seam_allowance)
+        pattern = nest.pattern
+        print(f"nested on a {args.roll_width:g} mm roll: {nest.length:.1f} mm used, efficiency {nest.efficiency:.1%}")
     report = _check(pattern, args)
     _print_panels(report)
     if suffix == ".dxf":
         pattern.to_dxf(args.output, profile=args.profile, seam_allowance=args.seam_allowance, units=args.units,
-                       version=args.dxf_version, arcs=args.arcs, bend_spacing=args.bend_spacing)
+                       version=args.dxf_version, arcs=args.arcs, bend_spacing=args.bend_spacing,
+                       notch_spacing=args.notch_spacing)
         print(f"wrote {args.output} ({args.profile} profile, {args.units})")
     else:
         from .export import write_flat_obj
@@ -339,12 +360,15 @@ def _batch_one(path: str, out: str, options: dict) -> dict:
                                units="mm")
         model = _load(args)
         pattern = flatten(model, method=options["method"], max_iterations=options["max_iterations"],
-                          thickness=options["thickness"], k_factor=options["k_factor"], reference=options["reference"])
+                          thickness=options["thickness"], k_factor=options["k_factor"], reference=options["reference"],
+                          grain=options["grain"])
+        if options["roll_width"] is not None:
+            pattern = pattern.layout(width=options["roll_width"], margin=options["seam_allowance"]).pattern
         report = check(pattern, max_strain=options["max_strain"], max_seam_mismatch=options["max_seam_mismatch"])
         stem = Path(out) / Path(path).stem
         pattern.to_dxf(stem.with_suffix(".dxf"), profile=options["profile"],
                        seam_allowance=options["seam_allowance"], version=options["dxf_version"], arcs=options["arcs"],
-                       bend_spacing=options["bend_spacing"])
+                       bend_spacing=options["bend_spacing"], notch_spacing=options["notch_spacing"])
         report.to_json(stem.with_suffix(".json"))
         row.update(panels=len(model.panels), seams=len(model.seams),
                    strain_rms=max(p.strain_rms for p in report.panels),
@@ -376,7 +400,8 @@ def _cmd_batch(args) -> int:
         raise InputError(f"{args.output}: cannot create the output folder ({exc.strerror})") from None
     options = {k: getattr(args, k) for k in ("max_edge", "tolerance", "method", "max_iterations", "max_strain",
                                               "max_seam_mismatch", "profile", "seam_allowance", "dxf_version",
-                                              "thickness", "k_factor", "reference", "arcs", "bend_spacing")}
+                                              "thickness", "k_factor", "reference", "arcs", "bend_spacing",
+                                              "grain", "notch_spacing", "roll_width")}
     progress = Progress(f"batch of {len(files)} files")
     rows = []
     if args.scheduler:

@@ -16,6 +16,7 @@ __all__ = [
     "ExportError",
     "FlattenError",
     "InputError",
+    "LayoutError",
     "MeshTopologyError",
     "PatternsError",
 ]
@@ -45,3 +46,7 @@ class FlattenError(PatternsError):
 
 class ExportError(PatternsError, OSError):
     """An output file could not be written."""
+
+
+class LayoutError(PatternsError):
+    """The panels cannot be laid out as asked (a panel wider than the roll in every allowed orientation)."""

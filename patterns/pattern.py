@@ -210,7 +210,8 @@ class Pattern:
     def to_dxf(self, path, *, profile: str = "machine", seam_allowance=0.0, units: str = "mm",
                version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
                gap: float | None = None, arcs: bool = False, arc_tolerance: float = 0.01,
-               bend_spacing: float | None = None) -> None:
+               bend_spacing: float | None = None, notch_spacing: float | None = None,
+               notch_style: str = "slit") -> None:
         """Write the pattern as a DXF file for a cutter (atomically).
 
         Parameters
@@ -245,12 +246,30 @@ class Pattern:
         bend_spacing : float, optional
             Draw the rulings of exactly developed cylinders and cones about this
             far apart (mm) on BEND with their bend angles (ASTM: layer 8).
+        notch_spacing : float, optional
+            Matching notches along every seam every this many mm of *3D* seam
+            length (and at both ends), on both panels: the pieces line up when
+            sewn even where the flat lengths differ.  Default: at the ends only.
+        notch_style : {"slit", "v"}
         """
         from .export.dxf import write_pattern_dxf
 
         write_pattern_dxf(self, path, profile=profile, seam_allowance=seam_allowance, units=units, version=version,
                           strain_layer=strain_layer, text_height=text_height, gap=gap, arcs=arcs,
-                          arc_tolerance=arc_tolerance, bend_spacing=bend_spacing)
+                          arc_tolerance=arc_tolerance, bend_spacing=bend_spacing, notch_spacing=notch_spacing,
+                          notch_style=notch_style)
+
+    def layout(self, *, width: float, gap: float = 10.0, margin: float = 0.0, allow_rotation: bool = True,
+               respect_grain: bool = True, step: float | None = None):
+        """Nest the panels on a roll ``width`` mm wide; see :func:`patterns.layout.layout`.
+
+        Returns a :class:`patterns.layout.Layout`: ``.pattern`` (laid out),
+        ``.length`` used, ``.efficiency``.
+        """
+        from .layout import layout
+
+        return layout(self, width=width, gap=gap, margin=margin, allow_rotation=allow_rotation,
+                      respect_grain=respect_grain, step=step)
 
     def heat_map(self, path, **options) -> None:
         """Write the strain heat map (PNG or SVG); see :func:`patterns.heat_map`."""

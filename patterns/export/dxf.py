@@ -68,6 +68,9 @@ def write_outline_dxf(path, loops: Sequence[np.ndarray], *, units: str = "mm", l
 PROFILES = ("machine", "astm")
 """DXF dialects :func:`write_pattern_dxf` writes."""
 
+NOTCH_STYLES = ("slit", "v")
+"""Notch shapes: a slit across the seam allowance, or a V."""
+
 MACHINE_LAYERS = {
     "CUT": 1,  # red: every cut contour, one closed polyline each
     "SEW": 5,  # blue: the seam line, when a seam allowance is added
@@ -246,34 +249,71 @@ def seam_label(flat_seam, side: int) -> str:
     return (f"S{flat_seam.seam.id} 3D {flat_seam.length:.2f} FLAT {flat_seam.flat_lengths[side]:.2f} MM")
 
 
-def _notches(pattern, geo, allowance_of):
-    """``(point on the seam line (2,), outward normal (2,), depth)`` at both ends of every seam on the panel."""
+def notch_positions(flat_seam, side: int, uv: np.ndarray, spacing: float | None) -> list:
+    """Where the notches of one side of a seam go: at equal 3D arc length on both sides.
+
+    Parameters
+    ----------
+    flat_seam : patterns.FlatSeam
+    side : int
+        0 or 1.
+    uv : (n, 2) float64
+        The flat positions of that side's panel (as placed).
+    spacing : float or None
+        A notch every ``spacing`` mm of 3D seam length, and at both ends; None:
+        at the ends only.
+
+    Returns
+    -------
+    list of (float, (2,) float64, (2,) float64)
+        The 3D arc length, the flat point, and the flat tangent (unit) there.
+    """
+    seam = flat_seam.seam
+    pts = uv[seam.vertices[side]]
+    c3 = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(seam.points, axis=0), axis=1))])
+    total = c3[-1]
+    if spacing:
+        marks = np.arange(0.0, total, spacing)
+        if total - marks[-1] < 0.25 * spacing:
+            marks = marks[:-1]  # not a notch a hair before the end one
+        marks = np.append(marks, total)
+    else:
+        marks = np.array([0.0, total])
+    out = []
+    for s in marks:
+        j = int(np.clip(np.searchsorted(c3, s, side="right") - 1, 0, len(c3) - 2))
+        t = (s - c3[j]) / max(c3[j + 1] - c3[j], 1e-300)
+        point = pts[j] + t * (pts[j + 1] - pts[j])
+        tangent = pts[j + 1] - pts[j]
+        out.append((float(s), point, tangent / max(np.linalg.norm(tangent), 1e-300)))
+    return out
+
+
+def _notches(pattern, geo, allowance_of, spacing=None):
+    """``(point on the seam line, outward normal, depth, outward?)`` for every notch on the panel."""
+    import shapely
+
     out = []
     for fs in pattern.seams:
         seam = fs.seam
-        for p, idx in zip(seam.panels, seam.vertices):
+        for side, p in enumerate(seam.panels):
             if p != geo.index:
                 continue
-            pts = geo.uv[idx]
-            for end, nxt in ((0, 1), (-1, -2)):
-                t = pts[nxt] - pts[end]
-                t = t / max(np.linalg.norm(t), 1e-12)
-                normal = np.array([t[1], -t[0]]) if end == 0 else np.array([-t[1], t[0]])
-                # Outward = away from the panel: check with a small step.
-                import shapely
-
-                probe = pts[end] + 0.5 * np.mean(np.linalg.norm(np.diff(pts, axis=0), axis=1)) * normal
-                if shapely.contains_xy(geo.polygon, *probe):
-                    normal = -normal
+            step = np.mean(np.linalg.norm(np.diff(geo.uv[seam.vertices[side]], axis=0), axis=1))
+            for _, point, tangent in notch_positions(fs, side, geo.uv, spacing):
+                normal = np.array([tangent[1], -tangent[0]])
+                if shapely.contains_xy(geo.polygon, *(point + 0.5 * step * normal)):
+                    normal = -normal  # outward = away from the panel
                 depth = allowance_of(seam.id)
-                out.append((pts[end], normal, depth if depth > 0 else 3.0, depth > 0))
+                out.append((point, normal, depth if depth > 0 else 3.0, depth > 0))
     return out
 
 
 def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance=0.0, units: str = "mm",
                       version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
                       gap: float | None = None, arcs: bool = False, arc_tolerance: float = 0.01,
-                      bend_spacing: float | None = None) -> None:
+                      bend_spacing: float | None = None, notch_spacing: float | None = None,
+                      notch_style: str = "slit") -> None:
     """Write a whole pattern as a DXF for cutters.
 
     See :meth:`patterns.Pattern.to_dxf` and docs/dxf.md for the two profiles.
@@ -302,6 +342,11 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
     if bend_spacing is not None and (isinstance(bend_spacing, bool) or not isinstance(bend_spacing, (int, float))
                                      or not bend_spacing > 0):
         raise InputError(f"{path}: bend_spacing must be a positive number of mm, got {bend_spacing!r}")
+    if notch_spacing is not None and (isinstance(notch_spacing, bool) or not isinstance(notch_spacing, (int, float))
+                                      or not notch_spacing > 0):
+        raise InputError(f"{path}: notch_spacing must be a positive number of mm, got {notch_spacing!r}")
+    if notch_style not in NOTCH_STYLES:
+        raise InputError(f"{path}: notch_style must be one of {', '.join(NOTCH_STYLES)}, got {notch_style!r}")
     if arcs and profile != "machine":
         raise InputError(f"{path}: arcs are written in the machine profile only")
     allowance_of = _allowance_lookup(seam_allowance, {s.seam.id for s in pattern.seams}, path)
@@ -311,13 +356,13 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
     geos = [_PanelGeometry(pattern, i, offsets[i], allowance_of, text_height) for i in range(len(pattern.panels))]
     if profile == "machine":
         doc = _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer,
-                           arc_tolerance if arcs else None, bend_spacing, offsets)
+                           arc_tolerance if arcs else None, bend_spacing, offsets, notch_spacing, notch_style)
         with atomic_output(path, what="DXF file") as tmp:
             doc.saveas(tmp)
     else:
         from ezdxf.addons import gerber_D6673
 
-        doc = _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets)
+        doc = _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets, notch_spacing, notch_style)
         with atomic_output(path, what="DXF file") as tmp:
             gerber_D6673.export_file(doc, tmp)
 
@@ -327,7 +372,7 @@ def _allowance_values(pattern, allowance_of):
 
 
 def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer, arc_tolerance,
-                 bend_spacing, offsets):
+                 bend_spacing, offsets, notch_spacing=None, notch_style="slit"):
     r12 = version == "R12"
     doc = _new_doc(ezdxf, version, 0 if r12 else UNITS[units])
     if not r12:
@@ -369,9 +414,16 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, stra
         if g.has_allowance:
             for loop in g.seam_loops:
                 poly(loop, "SEW")
-        for point, normal, depth, outward in _notches(pattern, g, allowance_of):
-            end = point + (normal if outward else -normal) * depth
-            msp.add_line(tuple(point * scale), tuple(end * scale), dxfattribs={"layer": "NOTCH"})
+        for point, normal, depth, outward in _notches(pattern, g, allowance_of, notch_spacing):
+            direction = normal if outward else -normal
+            if notch_style == "slit":
+                msp.add_line(tuple(point * scale), tuple((point + direction * depth) * scale),
+                             dxfattribs={"layer": "NOTCH"})
+            else:  # a V: its tip on the seam line, opening to the cut line, as wide as deep
+                side = np.array([-direction[1], direction[0]]) * 0.5 * depth
+                for arm in (side, -side):
+                    msp.add_line(tuple(point * scale), tuple((point + direction * depth + arm) * scale),
+                                 dxfattribs={"layer": "NOTCH"})
         a, b = _grain_line(g)
         msp.add_line(tuple(np.asarray(a) * scale), tuple(np.asarray(b) * scale), dxfattribs={"layer": "GRAIN"})
         text(g.name, g.label_at + [0.0, 0.8 * g.text_height], 1.2 * g.text_height)
@@ -448,7 +500,7 @@ def _strain_solids(msp, flat, uv, scale, truecolor):
         msp.add_solid([tuple(p[0]), tuple(p[1]), tuple(p[2])], dxfattribs=attribs)
 
 
-def _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets):
+def _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets, notch_spacing=None, notch_style="slit"):
     """ASTM D6673 (AAMA) R12 document: one block per piece, inserted on layer 1."""
     doc = _new_doc(ezdxf, "R12", 0)
     for layer in ASTM_LAYERS:
@@ -469,13 +521,16 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets):
         if g.has_allowance:
             for loop in g.seam_loops:
                 block.add_polyline2d(loop.tolist(), close=True, dxfattribs={"layer": "14"})
-        for point, normal, depth, outward in _notches(pattern, g, allowance_of):
-            # ASTM notch: a POINT on the cut line; z = depth, group 50 = angle (into the piece).
+        for point, normal, depth, outward in _notches(pattern, g, allowance_of, notch_spacing):
+            # ASTM notch: a POINT on the cut line; z = depth, group 50 = angle (into the
+            # piece), group 39 = width for a V notch.
             base = point + normal * depth if outward else point
             inward = -normal
             angle = float(np.degrees(np.arctan2(inward[1], inward[0])))
-            block.add_point((float(base[0]), float(base[1]), float(depth)),
-                            dxfattribs={"layer": "4", "angle": angle})
+            attribs = {"layer": "4", "angle": angle}
+            if notch_style == "v":
+                attribs["thickness"] = float(depth)
+            block.add_point((float(base[0]), float(base[1]), float(depth)), dxfattribs=attribs)
         block.add_line(*_grain_line(g), dxfattribs={"layer": "7"})
         if bend_spacing is not None:  # internal lines (layer 8): the rulings of a rolled panel
             for a, b, _ in pattern.panels[g.index].rulings(bend_spacing):

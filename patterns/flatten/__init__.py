@@ -238,7 +238,7 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
 
 
 def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: float = 0.0, k_factor: float = 0.5,
-            reference: str = "mid", max_iterations: int = 500, tolerance: float = 1e-4, progress=None):
+            reference: str = "mid", grain=None, max_iterations: int = 500, tolerance: float = 1e-4, progress=None):
     """Lay every panel of a model flat at true scale.
 
     Parameters
@@ -262,6 +262,12 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         Which skin the model shows.  The offset goes towards the convex side of
         cylinders and cones (away from their axis), along the face normal on
         freeform faces.
+    grain : (3,) float or mapping of panel name to (3,), optional
+        A 3D direction (the fabric's grain, a sheet's rolling direction): each
+        flat panel is turned so that this direction, as it lies on the panel,
+        points along +Y.  One direction for all panels, or one per panel name
+        (panels not named keep their orientation).  Only rotations: nothing
+        is scaled.
     max_iterations, tolerance
         ``"relaxed"`` only; see :func:`flatten_mesh`.
     progress : callable, optional
@@ -289,6 +295,7 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
     if method not in METHODS:
         raise InputError(f"unknown flattening method {method!r}; choose one of {', '.join(METHODS)}")
     offset = neutral_offset(thickness, k_factor, reference, name=model.name)
+    grains = _grain_table(grain, model)
     flat = []
     for i, panel in enumerate(model.panels):
         name = f"{model.name}: panel {panel.name}"
@@ -298,6 +305,8 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
             vertices = _offset_along_normals(panel, offset) if offset else panel.vertices
             result = flatten_mesh(vertices, panel.faces, method=method, max_iterations=max_iterations,
                                   tolerance=tolerance, name=name)
+        if panel.name in grains:
+            result = _turn_to_grain(result, grains[panel.name])
         flat.append(FlatPanel(panel.name, panel, result))
         if progress is not None:
             progress(i + 1, len(model.panels))
@@ -310,6 +319,60 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         seams.append(FlatSeam(seam, lengths))
     return Pattern(model=model, panels=tuple(flat), seams=tuple(seams), method=method,
                    thickness=float(thickness), k_factor=float(k_factor), reference=reference)
+
+
+def _grain_table(grain, model) -> dict:
+    """``{panel name: unit (3,) direction}`` from ``flatten(grain=...)``."""
+    if grain is None:
+        return {}
+    names = [p.name for p in model.panels]
+    items = grain.items() if hasattr(grain, "items") else [(n, grain) for n in names]
+    out = {}
+    for name, direction in items:
+        if name not in names:
+            raise InputError(f"{model.name}: grain names panel {name!r}, which the model does not have")
+        try:
+            d = np.asarray(direction, dtype=np.float64).reshape(3)
+        except (TypeError, ValueError):
+            raise InputError(f"{model.name}: a grain is a 3D direction (x, y, z), got {direction!r}") from None
+        if not np.all(np.isfinite(d)) or np.linalg.norm(d) == 0:
+            raise InputError(f"{model.name}: a grain is a non-zero 3D direction, got {direction!r}")
+        out[name] = d / np.linalg.norm(d)
+    return out
+
+
+def flat_direction(vertices, faces, uv, direction) -> np.ndarray:
+    """Where a 3D direction points in a flattening: the area-weighted mean of its images, (2,) unit.
+
+    On each triangle the direction is projected onto the triangle's plane and
+    carried to the plane by the triangle's own linear map.
+    """
+    p, q = vertices[faces], uv[faces]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    f1, f2 = q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]
+    # Solve direction ~ a e1 + b e2 (least squares on the triangle's plane): Gram system.
+    g11, g12, g22 = (e1 * e1).sum(1), (e1 * e2).sum(1), (e2 * e2).sum(1)
+    r1, r2 = e1 @ direction, e2 @ direction
+    det = g11 * g22 - g12 * g12
+    a = (g22 * r1 - g12 * r2) / det
+    b = (g11 * r2 - g12 * r1) / det
+    images = a[:, None] * f1 + b[:, None] * f2
+    area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
+    total = (images * area[:, None]).sum(axis=0)
+    norm = np.linalg.norm(total)
+    return total / norm if norm > 0 else np.array([0.0, 1.0])
+
+
+def _turn_to_grain(result: Flattening, direction) -> Flattening:
+    """The flattening turned about its centre so that ``direction`` points along +Y (a rotation)."""
+    from dataclasses import replace
+
+    d = flat_direction(result.vertices, result.faces, result.uv, direction)
+    angle = np.pi / 2 - np.arctan2(d[1], d[0])
+    c, s = np.cos(angle), np.sin(angle)
+    centre = result.uv.mean(axis=0)
+    uv = (result.uv - centre) @ np.array([[c, s], [-s, c]]) + centre
+    return replace(result, uv=_readonly(uv))
 
 
 def _developed(panel, offset: float, name: str) -> Flattening:
