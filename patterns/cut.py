@@ -25,7 +25,7 @@ from scipy.sparse import csgraph
 from .errors import MeshTopologyError
 from .mesh import check_boundary_vertices, edge_tables, trace_loops
 
-__all__ = ["Cut", "cut_to_disk", "pieces"]
+__all__ = ["Cut", "cut_along", "cut_to_disk", "pieces"]
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -264,3 +264,27 @@ def _cut_along(vertices, faces, t, paths) -> Cut:
         sides.append((_readonly(left.astype(np.int64)), _readonly(right.astype(np.int64))))
     return Cut(_readonly(vertices[source].copy()), _readonly(new_faces), _readonly(source),
                tuple(_readonly(np.asarray(p, dtype=np.int64)) for p in paths), tuple(sides))
+
+
+def cut_along(vertices: np.ndarray, faces: np.ndarray, path, *, name: str = "mesh") -> Cut:
+    """Cut a mesh along one path of edges (a slit or a dart from the boundary).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    path : (p,) int64
+        Vertex indices joined by mesh edges; where it starts or ends on the
+        boundary the cut opens there, where it ends inside the surface the slit
+        stops.
+    name : str
+
+    Returns
+    -------
+    Cut
+        The input vertices keep their indices; the copies on the cut's second
+        side come after them.
+    """
+    path = np.asarray(path, dtype=np.int64)
+    t = edge_tables(faces, len(vertices), name=name)
+    return _cut_along(vertices, faces, t, [path])

@@ -31,6 +31,9 @@ class FlatPanel:
     panel: object
     flattening: object
     placement: tuple = (0.0, 0.0, 0.0)
+    darts: tuple = ()
+    """Cuts made by ``flatten(..., max_strain=...)``: each a ``(k,)`` int64 path of
+    vertex indices (into :attr:`vertices`), from the outline inwards."""
     """``(angle, dx, dy)``: the rigid motion (radians, mm) that puts the
     flattened panel where it lies on the sheet: rotate about the origin, then
     move.  ``(0, 0, 0)`` until the pattern is laid out."""
@@ -126,12 +129,12 @@ class FlatPanel:
     @property
     def faces(self) -> np.ndarray:
         """(m, 3) int64: the triangles (counter-clockwise in the plane)."""
-        return self.panel.faces
+        return self.flattening.faces
 
     @property
     def loops(self) -> tuple:
-        """Outline loops (vertex indices), the outer one first."""
-        return self.panel.loops
+        """Outline loops (vertex indices), the outer one first (darts open it)."""
+        return self.flattening.loops if self.darts else self.panel.loops
 
     def outline(self, loop: int = 0) -> np.ndarray:
         """(k, 2) float64, mm: flat points of one outline loop (not repeated at the end)."""

@@ -238,7 +238,8 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
 
 
 def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: float = 0.0, k_factor: float = 0.5,
-            reference: str = "mid", grain=None, max_iterations: int = 500, tolerance: float = 1e-4, progress=None):
+            reference: str = "mid", grain=None, max_strain: float | None = None, max_darts: int = 60,
+            max_iterations: int = 500, tolerance: float = 1e-4, progress=None):
     """Lay every panel of a model flat at true scale.
 
     Parameters
@@ -268,6 +269,15 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         points along +Y.  One direction for all panels, or one per panel name
         (panels not named keep their orientation).  Only rotations: nothing
         is scaled.
+    max_strain : float, optional
+        Largest acceptable triangle strain (0.03 = 3 %).  A freeform panel that
+        comes out above it is cut, one dart at a time, from the outline to its
+        most strained point by the shortest path along its edges (the paper's
+        "segmentation"), and flattened again, until it is within the limit or
+        ``max_darts`` cuts are made (``patterns.check`` then reports it).
+        Every cut is in :attr:`FlatPanel.darts`.
+    max_darts : int
+        At most this many darts per panel.
     max_iterations, tolerance
         ``"relaxed"`` only; see :func:`flatten_mesh`.
     progress : callable, optional
@@ -296,18 +306,26 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         raise InputError(f"unknown flattening method {method!r}; choose one of {', '.join(METHODS)}")
     offset = neutral_offset(thickness, k_factor, reference, name=model.name)
     grains = _grain_table(grain, model)
+    if max_strain is not None and (isinstance(max_strain, bool) or not isinstance(max_strain, (int, float))
+                                   or not np.isfinite(max_strain) or max_strain <= 0):
+        raise InputError(f"{model.name}: max_strain must be a positive number, got {max_strain!r}")
+    if isinstance(max_darts, bool) or not isinstance(max_darts, (int, np.integer)) or max_darts < 0:
+        raise InputError(f"{model.name}: max_darts must be an integer >= 0, got {max_darts!r}")
     flat = []
     for i, panel in enumerate(model.panels):
         name = f"{model.name}: panel {panel.name}"
+        darts = ()
         if exact and panel.surface is not None:
             result = _developed(panel, offset, name)
         else:
             vertices = _offset_along_normals(panel, offset) if offset else panel.vertices
             result = flatten_mesh(vertices, panel.faces, method=method, max_iterations=max_iterations,
                                   tolerance=tolerance, name=name)
+            if max_strain is not None:
+                result, darts = _with_darts(result, max_strain, max_darts, method, max_iterations, tolerance, name)
         if panel.name in grains:
             result = _turn_to_grain(result, grains[panel.name])
-        flat.append(FlatPanel(panel.name, panel, result))
+        flat.append(FlatPanel(panel.name, panel, result, darts=darts))
         if progress is not None:
             progress(i + 1, len(model.panels))
     seams = []
@@ -319,6 +337,57 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         seams.append(FlatSeam(seam, lengths))
     return Pattern(model=model, panels=tuple(flat), seams=tuple(seams), method=method,
                    thickness=float(thickness), k_factor=float(k_factor), reference=reference)
+
+
+def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_iterations, tolerance, name):
+    """Cut darts into a flattening until its triangle strain is within ``limit``.
+
+    Greedy: each round finds the triangles above the limit, takes the one that
+    is closest to the outline among the worst tenth of them (the shortest cut
+    first), cuts along the shortest path of edges from the outline to its most
+    strained corner, and flattens again.  Returns ``(flattening, darts)``.
+    """
+    import scipy.sparse as sp
+    from scipy.sparse import csgraph
+
+    from ..cut import cut_along
+    from ..measure import triangle_strains
+
+    darts = []
+    for _ in range(max_darts):
+        v, f = result.vertices, result.faces
+        mag = triangle_strains(v, f, result.uv).magnitude
+        above = np.flatnonzero(mag > limit)
+        if not len(above):
+            break
+        n = len(v)
+        edges = np.unique(np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1), axis=0)
+        weight = np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)
+        graph = sp.coo_matrix((np.r_[weight, weight], (np.r_[edges[:, 0], edges[:, 1]],
+                                                        np.r_[edges[:, 1], edges[:, 0]])), shape=(n, n)).tocsr()
+        boundary = np.unique(np.concatenate(result.loops))
+        dist, pred, _ = csgraph.dijkstra(graph, indices=boundary, min_only=True, return_predecessors=True)
+        # The vertex to cut to: among the vertices next to a triangle above the
+        # limit, the one deepest inside (farthest from the outline along the
+        # mesh), so that one dart relieves the whole strained run.
+        strained = np.zeros(n, dtype=bool)
+        strained[f[above].ravel()] = True
+        strained[boundary] = False
+        if not strained.any():
+            break  # every strained triangle lies on the outline: nothing left to cut
+        candidates = np.flatnonzero(strained & np.isfinite(dist))
+        target = int(candidates[np.argmax(dist[candidates])])
+        path = [target]
+        while pred[path[-1]] >= 0:
+            path.append(int(pred[path[-1]]))
+        path = np.asarray(path[::-1], dtype=np.int64)  # from the outline inwards
+        if len(path) < 2:
+            break
+        cut = cut_along(v, f, path, name=name)
+        darts.append(path)
+        result = flatten_mesh(cut.vertices, cut.faces, method=method, max_iterations=max_iterations,
+                              tolerance=tolerance, name=name)
+    return result, tuple(np.asarray(d) for d in darts)
 
 
 def _grain_table(grain, model) -> dict:
