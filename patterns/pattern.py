@@ -214,7 +214,7 @@ class Pattern:
                version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
                gap: float | None = None, arcs: bool = False, arc_tolerance: float = 0.01,
                bend_spacing: float | None = None, notch_spacing: float | None = None,
-               notch_style: str = "slit") -> None:
+               notch_style: str = "slit", seam_corners: str = "mitre") -> None:
         """Write the pattern as a DXF file for a cutter (atomically).
 
         Parameters
@@ -254,13 +254,16 @@ class Pattern:
             length (and at both ends), on both panels: the pieces line up when
             sewn even where the flat lengths differ.  Default: at the ends only.
         notch_style : {"slit", "v"}
+        seam_corners : {"mitre", "square"}
+            Corners of the seam allowance: offset lines meeting at a point, or
+            each side's allowance run straight on past the corner (squared).
         """
         from .export.dxf import write_pattern_dxf
 
         write_pattern_dxf(self, path, profile=profile, seam_allowance=seam_allowance, units=units, version=version,
                           strain_layer=strain_layer, text_height=text_height, gap=gap, arcs=arcs,
                           arc_tolerance=arc_tolerance, bend_spacing=bend_spacing, notch_spacing=notch_spacing,
-                          notch_style=notch_style)
+                          notch_style=notch_style, seam_corners=seam_corners)
 
     def layout(self, *, width: float, gap: float = 10.0, margin: float = 0.0, allow_rotation: bool = True,
                respect_grain: bool = True, step: float | None = None):

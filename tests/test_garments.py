@@ -20,9 +20,9 @@ from .conftest import SAMPLES
 
 @pytest.fixture(scope="module")
 def cup_pattern():
-    # Tighter than the default tolerance: mating seams' flat lengths are then
-    # within 0.1 % (measured 0.091-0.096 %; 0.063-0.129 % at the default 1e-4).
-    return patterns.flatten(patterns.load(SAMPLES / "cup.step"), tolerance=1e-6)
+    # flatten's default tolerance (1e-6) relaxes to convergence: mating seams' flat
+    # lengths are then within 0.1 % (measured 0.091-0.096 %; 0.063-0.129 % at 1e-4).
+    return patterns.flatten(patterns.load(SAMPLES / "cup.step"))
 
 
 def test_grain_points_up_on_every_panel():
@@ -175,3 +175,38 @@ def test_max_strain_options():
         patterns.flatten(model, max_strain=0.03, max_darts=-1)
     # A limit that already holds cuts nothing.
     assert all(f.darts == () for f in patterns.flatten(model, max_strain=0.5).panels)
+
+
+def test_squared_seam_allowance_corners(cup_pattern, tmp_path):
+    laid = cup_pattern.placed([(0.0, 300.0 * k, 0.0) for k in range(4)])
+    outlines = {}
+    for corners in ("mitre", "square"):
+        path = tmp_path / f"{corners}.dxf"
+        laid.to_dxf(path, seam_allowance=10.0, seam_corners=corners)
+        doc = ezdxf.readfile(path)
+        cuts = [shapely.Polygon([q[:2] for q in e.get_points("xy")]) for e in doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')]
+        outlines[corners] = min(cuts, key=lambda c: c.bounds[0])  # panel 0
+    flat = laid.panels[0]
+    seam_line = flat.uv[flat.loops[0]]
+    for cut in outlines.values():
+        d = shapely.distance(shapely.points(seam_line), cut.exterior)
+        assert d.min() > 10.0 - 1e-3  # the allowance is there all round
+    # At each sharp corner of the seam line, the squared outline runs each side on
+    # by the allowance: both extension points lie on the cut line.
+    loop = seam_line
+    a_vec = loop - np.roll(loop, 1, axis=0)
+    b_vec = np.roll(loop, -1, axis=0) - loop
+    turn = np.arctan2(a_vec[:, 0] * b_vec[:, 1] - a_vec[:, 1] * b_vec[:, 0], (a_vec * b_vec).sum(axis=1))
+    sharp = np.flatnonzero(turn > np.radians(30))
+    assert len(sharp) == 3  # the quarter sphere's three corners
+    ring = outlines["square"].exterior
+    for i in sharp:
+        for t in (a_vec[i], -b_vec[i]):
+            outward = np.array([t[1], -t[0]]) / np.linalg.norm(t)
+            if shapely.contains_xy(shapely.Polygon(loop), *(loop[i] + 1e-3 * outward)):
+                outward = -outward
+            corner = loop[i] + 10.0 * t / np.linalg.norm(t) + 10.0 * outward
+            assert ring.distance(shapely.Point(corner)) < 0.05
+    assert abs(outlines["square"].area - outlines["mitre"].area) > 1.0
+    with pytest.raises(InputError, match="seam_corners"):
+        laid.to_dxf(tmp_path / "x.dxf", seam_allowance=10.0, seam_corners="round")

@@ -94,7 +94,7 @@ MACHINE_VERSIONS = {"R12": "AC1009", "R2000": "AC1015", "R2004": "AC1018", "R200
 class _PanelGeometry:
     """Flat geometry of one panel as it goes into the file (mm, placed)."""
 
-    def __init__(self, pattern, index, offset, allowances, text_height):
+    def __init__(self, pattern, index, offset, allowances, text_height, corners="mitre"):
         import shapely
 
         flat = pattern.panels[index]
@@ -114,7 +114,7 @@ class _PanelGeometry:
         polygon = shapely.Polygon(self.seam_loops[0], self.seam_loops[1:])
         self.polygon = polygon
         if self.has_allowance:
-            cut = _allowance_outline(polygon, self.seam_loops, per_segment)
+            cut = _allowance_outline(polygon, self.seam_loops, per_segment, corners)
             self.cut_loops = [np.asarray(cut.exterior.coords)[:-1]] + [np.asarray(r.coords)[:-1] for r in cut.interiors]
         else:
             self.cut_loops = self.seam_loops
@@ -145,12 +145,20 @@ def _segment_seams(pattern, index) -> dict:
     return out
 
 
-def _allowance_outline(polygon, loops, per_segment):
-    """The cut outline: the seam line offset outwards by each segment's allowance (mitred corners)."""
+def _allowance_outline(polygon, loops, per_segment, corners="mitre"):
+    """The cut outline: the seam line offset outwards by each segment's allowance.
+
+    ``corners="mitre"``: offset lines meet at a point (mitre limit 4).
+    ``"square"``: at every sharp corner (turning by more than 30 degrees
+    towards the material's outside) each side's allowance is run straight on
+    past the corner by its own width, so the corner is squared off.
+    """
     import shapely
 
     values = np.concatenate(per_segment)
     base = float(values.min())
+    if corners == "square":
+        return _square_allowance(polygon, loops, per_segment)
     cut = polygon.buffer(base, join_style="mitre", mitre_limit=4.0) if base > 0 else polygon
     parts = [cut]
     for loop, allow in zip(loops, per_segment):
@@ -175,6 +183,44 @@ def _allowance_outline(polygon, loops, per_segment):
     out = shapely.union_all(parts)
     if out.geom_type != "Polygon":
         out = max(getattr(out, "geoms", [out]), key=lambda g: g.area)
+    return shapely.orient_polygons(out) if hasattr(shapely, "orient_polygons") else _orient(out)
+
+
+def _square_allowance(polygon, loops, per_segment):
+    """Allowance with squared corners: each run between sharp corners offset on its own, extended."""
+    import shapely
+
+    parts = [polygon]
+    for loop, allow in zip(loops, per_segment):
+        n = len(loop)
+        a_vec = loop - np.roll(loop, 1, axis=0)
+        b_vec = np.roll(loop, -1, axis=0) - loop
+        turn = np.arctan2(a_vec[:, 0] * b_vec[:, 1] - a_vec[:, 1] * b_vec[:, 0], (a_vec * b_vec).sum(axis=1))
+        # Corners: sharp turns, and where the allowance changes.
+        cut_at = np.flatnonzero((np.abs(turn) > np.radians(30)) | (allow != np.roll(allow, 1)))
+        if not len(cut_at):
+            cut_at = np.array([0])
+        for k, s in enumerate(cut_at):
+            e = cut_at[(k + 1) % len(cut_at)]
+            if e <= s:
+                e += n
+            a = float(allow[s % n])
+            if a <= 0:
+                continue
+            run = loop[np.arange(s, e + 1) % n].copy()
+            # Run straight on past a convex corner (the material on the left turns left there).
+            if turn[s % n] > np.radians(30):
+                t = run[0] - run[1]
+                run = np.vstack([run[0] + a * t / np.linalg.norm(t), run])
+            if turn[e % n] > np.radians(30):
+                t = run[-1] - run[-2]
+                run = np.vstack([run, run[-1] + a * t / np.linalg.norm(t)])
+            parts.append(shapely.buffer(shapely.LineString(run), -a, single_sided=True, join_style="mitre",
+                                        cap_style="flat", mitre_limit=4.0))
+    out = shapely.union_all(parts)
+    if out.geom_type != "Polygon":
+        out = max(getattr(out, "geoms", [out]), key=lambda g: g.area)
+    # Holes of the panel shrink by their allowance: take the holes of the union.
     return shapely.orient_polygons(out) if hasattr(shapely, "orient_polygons") else _orient(out)
 
 
@@ -313,7 +359,7 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
                       version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
                       gap: float | None = None, arcs: bool = False, arc_tolerance: float = 0.01,
                       bend_spacing: float | None = None, notch_spacing: float | None = None,
-                      notch_style: str = "slit") -> None:
+                      notch_style: str = "slit", seam_corners: str = "mitre") -> None:
     """Write a whole pattern as a DXF for cutters.
 
     See :meth:`patterns.Pattern.to_dxf` and docs/dxf.md for the two profiles.
@@ -345,6 +391,8 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
     if notch_spacing is not None and (isinstance(notch_spacing, bool) or not isinstance(notch_spacing, (int, float))
                                       or not notch_spacing > 0):
         raise InputError(f"{path}: notch_spacing must be a positive number of mm, got {notch_spacing!r}")
+    if seam_corners not in ("mitre", "square"):
+        raise InputError(f"{path}: seam_corners must be 'mitre' or 'square', got {seam_corners!r}")
     if notch_style not in NOTCH_STYLES:
         raise InputError(f"{path}: notch_style must be one of {', '.join(NOTCH_STYLES)}, got {notch_style!r}")
     if arcs and profile != "machine":
@@ -353,7 +401,8 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
     scale = {"mm": 1.0, "cm": 0.1, "m": 0.001, "in": 1 / 25.4}[units]
     biggest = max(float(np.max(_allowance_values(pattern, allowance_of))), 0.0)
     offsets = display_offsets(pattern, gap=gap if gap is not None else None, margin=biggest)
-    geos = [_PanelGeometry(pattern, i, offsets[i], allowance_of, text_height) for i in range(len(pattern.panels))]
+    geos = [_PanelGeometry(pattern, i, offsets[i], allowance_of, text_height, seam_corners)
+            for i in range(len(pattern.panels))]
     if profile == "machine":
         doc = _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer,
                            arc_tolerance if arcs else None, bend_spacing, offsets, notch_spacing, notch_style)
