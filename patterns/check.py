@@ -137,6 +137,7 @@ class Code(str, Enum):
     STRAIN_ABOVE_LIMIT = "strain-above-limit"
     SEAM_MISMATCH_ABOVE_LIMIT = "seam-mismatch-above-limit"
     NOT_CONVERGED = "not-converged"
+    DARTS = "darts"
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,6 +205,8 @@ class PanelReport:
     one_to_one: bool
     iterations: int
     converged: bool
+    darts: int = 0
+    """Darts cut by ``flatten(..., max_strain=...)``."""
 
 
 @dataclass(frozen=True)
@@ -356,6 +359,12 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
                     f"({len(above)} triangles), up to {mag[worst]:.2%} at ({centre[0]:.1f}, {centre[1]:.1f}) mm"))
         findings += _panel_overlaps(flat)
         res = flat.flattening
+        if flat.darts:
+            tips = np.array([uv[d[-1]] for d in flat.darts])
+            length = sum(float(np.linalg.norm(np.diff(vertices[d], axis=0), axis=1).sum()) for d in flat.darts)
+            findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), _ro(tips), np.zeros(0, dtype=np.int64),
+                                    None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
+                                          f"the limit ({length:.1f} mm of cuts; points: their tips)"))
         if not res.converged:
             findings.append(Finding(Code.NOT_CONVERGED, Severity.NOTE, (flat.name,), np.zeros((0, 2)),
                                     np.zeros(0, dtype=np.int64), None,
@@ -367,7 +376,7 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
             strain_rms=rms, strain_max=biggest, strain_p95=p95, share_above_limit=share,
             edge_strain_rms=float(np.sqrt(np.mean(es**2))), edge_strain_max=float(es.max()),
             n_folded=int(np.count_nonzero(ts.area_change <= -1.0)), one_to_one=bool(res.one_to_one),
-            iterations=int(res.iterations), converged=bool(res.converged)))
+            iterations=int(res.iterations), converged=bool(res.converged), darts=len(flat.darts)))
     findings += _overlaps_between(pattern)
     seam_reports = []
     for fs in pattern.seams:

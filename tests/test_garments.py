@@ -162,8 +162,11 @@ def test_darts_bring_a_hemisphere_within_the_strain_limit():
     assert first[0] in boundary_before and first[-1] not in boundary_before
     edges = {tuple(sorted(e)) for e in np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]).tolist()}
     assert all(tuple(sorted(e)) in edges for e in zip(first[:-1].tolist(), first[1:].tolist()))
-    # The report agrees, and the outline runs into every dart.
-    assert patterns.check(patterns.flatten(model, max_strain=0.03), max_strain=0.03).ok
+    # The report agrees and lists the darts, and the outline runs into every dart.
+    report = patterns.check(patterns.flatten(model, max_strain=0.03), max_strain=0.03)
+    assert report.ok and report.panels[0].darts == len(flat.darts)
+    (note,) = [f for f in report.findings if f.code.value == "darts"]
+    assert len(note.points) == len(flat.darts)
     assert sum(len(loop) for loop in flat.loops) > sum(len(loop) for loop in plain.loops)
 
 
