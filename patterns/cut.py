@@ -62,20 +62,22 @@ class Cut:
     sides: tuple
 
 
-def pieces(faces: np.ndarray, n_vertices: int) -> list[np.ndarray]:
+def pieces(faces: np.ndarray, n_vertices: int, *, name: str = "mesh") -> list[np.ndarray]:
     """Split faces into connected pieces (joined through shared edges).
 
     Parameters
     ----------
     faces : (m, 3) int64
     n_vertices : int
+    name : str
+        For error messages.
 
     Returns
     -------
     list of (m_i,) int64
         Face indices of each piece, in order of their first face.
     """
-    t = edge_tables(faces, n_vertices)
+    t = edge_tables(faces, n_vertices, name=name)
     pairs = t.edge_faces[t.edge_faces[:, 1] >= 0]
     m = len(faces)
     adjacency = sp.coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(m, m))

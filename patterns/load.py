@@ -306,7 +306,7 @@ def mesh_model(vertices, faces, *, name: str = "mesh"):
 
     v, f = as_mesh_arrays(vertices, faces, name=name)
     panels, seams = [], []
-    groups = pieces(f, len(v))
+    groups = pieces(f, len(v), name=name)
     for i, group in enumerate(groups):
         label = f"piece{i}"
         pname = name if len(groups) == 1 else f"{name}: {label}"

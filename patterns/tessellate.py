@@ -16,7 +16,7 @@ from .load import drop_unused
 from .cut import cut_to_disk
 from .mesh import face_areas, validate_mesh
 
-__all__ = ["DEFAULT_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
+__all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
 
 
 def tessellate_face(face, *, tolerance: float = 0.05, angular_tolerance: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
@@ -76,6 +76,10 @@ the whole shape's area (before curvature refines it)..."""
 
 MIN_FACE_TRIANGLES = 1000
 """... and each face at least about this many of its own."""
+
+MAX_TRIANGLES = 4_000_000
+"""Meshing that would make more triangles than this is refused (CadError) before it starts:
+a tiny ``max_edge`` or ``tolerance`` must not hang the machine."""
 
 _GRID = 41  # samples per parameter direction of a face's development table
 
@@ -417,6 +421,11 @@ class _ShapeMesher:
                 hf = min(hf, np.sqrt(8 * tolerance / kappa), angular_tolerance / kappa)
             face_h.append(max(hf, h / 50))
         self.face_h = face_h
+        estimate = sum(a / (0.433 * hf * hf) for a, hf in zip(areas, face_h))
+        if estimate > MAX_TRIANGLES:
+            raise CadError(f"{self.name}: meshing at max_edge {min(face_h):.3g} mm (tolerance {tolerance:g} mm) "
+                           f"would make about {estimate:.3g} triangles, over the limit of {MAX_TRIANGLES:.0e}; "
+                           f"use a larger max_edge or tolerance")
         edge_faces = [[] for _ in self.edges.items]
         for k, wires in enumerate(self.wires):
             for walk in wires:

@@ -58,7 +58,7 @@ def write_outline_dxf(path, loops: Sequence[np.ndarray], *, units: str = "mm", l
     for loop in loops:
         msp.add_lwpolyline(np.asarray(loop, dtype=np.float64).tolist(), close=True, dxfattribs={"layer": layer})
     with atomic_output(path, what="DXF file") as tmp:
-        doc.saveas(tmp)
+        _save(doc, tmp)
 
 
 # --------------------------------------------------------------------------- #
@@ -407,7 +407,7 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
         doc = _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer,
                            arc_tolerance if arcs else None, bend_spacing, offsets, notch_spacing, notch_style)
         with atomic_output(path, what="DXF file") as tmp:
-            doc.saveas(tmp)
+            _save(doc, tmp)
     else:
         from ezdxf.addons import gerber_D6673
 
@@ -493,6 +493,28 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, stra
         text(f"UNITS: {units.upper()}", [geos[0].box[0], geos[0].box[1] - 3 * geos[0].text_height],
              geos[0].text_height)
     return doc
+
+
+def _save(doc, path) -> None:
+    """Save with fixed metadata (dates 2000-01-01, constant GUIDs): the same pattern and
+    options always give a byte-identical file."""
+    import ezdxf
+
+    import re
+    from pathlib import Path
+
+    old = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True
+    try:
+        doc.saveas(path)
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = old
+    # ezdxf also stamps its own "created/written by" records with the time of day.
+    path = Path(path)
+    text = path.read_text(encoding=doc.output_encoding, errors="surrogateescape")
+    fixed = re.sub(r"(\d+\.\d+\.\d+) @ \d{4}-\d\d-\d\dT[\d:.]+\+00:00", r"\1 @ 2000-01-01T00:00:00+00:00", text)
+    if fixed != text:
+        path.write_text(fixed, encoding=doc.output_encoding, errors="surrogateescape")
 
 
 def _new_doc(ezdxf, version, units):

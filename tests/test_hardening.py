@@ -1,0 +1,172 @@
+"""Bad input of every kind gets one clear error naming the file, leaves no file behind,
+and cannot hang; the same input gives byte-identical output; properties over random meshes."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import patterns
+from patterns import surfaces
+from patterns.errors import CadError, InputError, MeshTopologyError, PatternsError
+
+from .conftest import SAMPLES
+
+EXE = Path(sys.executable).with_name("patterns")
+RNG = np.random.default_rng(2026)
+
+
+def _noise(n):
+    return bytes(RNG.integers(0, 256, n, dtype=np.uint8))
+
+
+def _mesh_bytes(suffix):
+    v, f = surfaces.paraboloid_dish(n_faces=200)
+    path = Path(os.environ.get("TMPDIR", "/tmp")) / f"_hardening_source{suffix}"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    data = path.read_bytes()
+    path.unlink()
+    return data
+
+
+FILES = {
+    # name: (bytes, error class, words in the message)
+    "empty.step": (b"", CadError, "empty"),
+    "empty.iges": (b"", CadError, "empty"),
+    "empty.brep": (b"", CadError, "empty"),
+    "empty.stl": (b"", InputError, ""),
+    "empty.obj": (b"", InputError, "no triangles"),
+    "empty.ply": (b"", InputError, ""),
+    "noise.step": (_noise(5000), CadError, "not a readable STEP"),
+    "noise.iges": (_noise(5000), CadError, "IGES"),
+    "noise.brep": (_noise(5000), CadError, "BREP"),
+    "noise.stl": (_noise(5000), InputError, ""),
+    "noise.ply": (_noise(5000), InputError, ""),
+    "truncated.step": ((SAMPLES / "cup.step").read_bytes()[:2000], CadError, ""),
+    "truncated.stl": (_mesh_bytes(".stl")[:1000], InputError, ""),
+    "truncated.ply": (_mesh_bytes(".ply")[:600], InputError, ""),
+    "nan.obj": (b"v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n", InputError, "NaN"),
+    "inf.obj": (b"v 0 0 0\nv 1 0 0\nv inf 1 0\nf 1 2 3\n", InputError, "NaN or infinite"),
+    "range.off": (b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", InputError, ""),
+    "negative.off": (b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -2\n", InputError, ""),
+    "zero_area.obj": (b"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 4 2\n", InputError, "degenerate"),
+    "duplicate_faces.obj": (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 3\n", MeshTopologyError, ""),
+    "nonmanifold.obj": (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+                        MeshTopologyError, "non-manifold"),
+    "winding.obj": (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 3 4\n", MeshTopologyError,
+                    "not consistently wound"),
+    "unknown.xyz": (b"1 2 3", InputError, "unknown file type"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(FILES))
+def test_bad_files_library_and_command_line(tmp_path, name):
+    data, error, words = FILES[name]
+    path = tmp_path / name
+    path.write_bytes(data)
+    with pytest.raises(error) as info:
+        patterns.flatten(patterns.load(path))
+    message = str(info.value)
+    assert name in message and words in message and "\n" not in message
+    if not EXE.exists():
+        pytest.skip(f"the entry point {EXE} is not installed")
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = subprocess.run([str(EXE), "flatten", str(path), "-o", str(out / "x.dxf"), "--report", str(out / "r.json")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stdout + proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("patterns: error: ") and name in lines[0]
+    assert "Traceback" not in proc.stderr
+    assert list(out.iterdir()) == []  # no partial output
+
+
+def test_closed_surfaces_several_pieces_and_flipped_normals_are_handled(tmp_path):
+    # Not errors: a closed surface is cut open, pieces become panels, a mesh wound
+    # the other way round flattens mirrored -- still one-to-one.
+    ball = trimesh.creation.icosphere(subdivisions=2, radius=40.0)
+    box = trimesh.creation.box(extents=(30, 20, 10))
+    box.apply_translation((100, 0, 0))
+    both = trimesh.util.concatenate([ball, box])
+    path = tmp_path / "two.ply"
+    both.export(path)
+    pattern = patterns.flatten(patterns.load(path))
+    assert len(pattern.panels) == 2 and len(pattern.seams) == 2 and pattern.one_to_one
+    v, f = surfaces.paraboloid_dish(n_faces=500)
+    flipped = patterns.flatten_mesh(v, f[:, ::-1])
+    assert flipped.one_to_one and flipped.n_folded == 0
+
+
+@pytest.mark.parametrize("scale,offset", [(1e-9, 0.0), (1.0, 1e9), (1e6, 0.0)])
+def test_extreme_coordinates(scale, offset):
+    v, f = surfaces.paraboloid_dish(diameter=600.0, sag=54.0, n_faces=1000)
+    reference = patterns.flatten_mesh(v, f)
+    result = patterns.flatten_mesh(v * scale + offset, f)
+    assert result.one_to_one and np.all(np.isfinite(result.uv))
+    assert result.distortion.edge_strain_rms == pytest.approx(reference.distortion.edge_strain_rms, rel=0.02, abs=1e-6)
+
+
+def test_meshing_limits_refuse_instead_of_hanging():
+    import build123d as bd
+
+    with pytest.raises(CadError, match="would make about .* triangles, over the limit"):
+        patterns.load(bd.Box(1000, 1000, 1000), max_edge=0.01)
+
+
+def test_same_input_gives_byte_identical_files(tmp_path):
+    if not EXE.exists():
+        pytest.skip(f"the entry point {EXE} is not installed")
+    outputs = []
+    for run in range(2):
+        folder = tmp_path / f"run{run}"
+        folder.mkdir()
+        proc = subprocess.run([str(EXE), "flatten", str(SAMPLES / "cup.step"), "-o", str(folder / "cup.dxf"),
+                               "--report", str(folder / "cup.json"), "--seam-allowance", "8"],
+                              capture_output=True, text=True, timeout=300)
+        assert proc.returncode == 0, proc.stderr
+        subprocess.run([str(EXE), "flatten", str(SAMPLES / "cup.step"), "-o", str(folder / "astm.dxf"),
+                        "--profile", "astm"], capture_output=True, text=True, timeout=300, check=True)
+        outputs.append([(folder / n).read_bytes() for n in ("cup.dxf", "cup.json", "astm.dxf")])
+    assert outputs[0] == outputs[1]
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000), bump=st.floats(0.0, 0.6), n=st.integers(150, 900))
+def test_random_disk_meshes(tmp_path_factory, seed, bump, n):
+    """Random disks lifted to random smooth height fields: the default method never
+    folds, never gives NaN, is one-to-one, and the DXF reads back with the same outline."""
+    import shapely
+    from ezdxf import recover
+
+    rng = np.random.default_rng(seed)
+    p, f = surfaces.disk_mesh(n)
+    p = p + rng.normal(scale=0.01, size=p.shape) * (np.linalg.norm(p, axis=1, keepdims=True) < 0.95)
+    c = rng.normal(size=4)
+    z = bump * (c[0] * p[:, 0] ** 2 + c[1] * p[:, 1] ** 2 + c[2] * p[:, 0] * p[:, 1] + c[3] * p[:, 0])
+    v = np.column_stack([p * 100.0, z * 100.0])
+    result = patterns.flatten_mesh(v, f)
+    assert np.all(np.isfinite(result.uv))
+    assert result.n_folded == 0 and result.one_to_one
+    path = tmp_path_factory.mktemp("dxf") / "disk.dxf"
+    from patterns.export.dxf import write_outline_dxf
+
+    write_outline_dxf(path, [result.uv[loop] for loop in result.loops])
+    doc, auditor = recover.readfile(path)
+    assert not auditor.has_errors
+    (cut,) = doc.modelspace().query("LWPOLYLINE")
+    area = shapely.Polygon([q[:2] for q in cut.get_points("xy")]).area
+    assert area == pytest.approx(shapely.Polygon(result.uv[result.loops[0]]).area, rel=1e-9)
+
+
+def test_every_error_is_a_patterns_error_and_a_builtin():
+    assert issubclass(InputError, ValueError) and issubclass(MeshTopologyError, InputError)
+    assert issubclass(patterns.ExportError, OSError)
+    for cls in (InputError, MeshTopologyError, CadError, patterns.FlattenError, patterns.ExportError,
+                patterns.LayoutError):
+        assert issubclass(cls, PatternsError)
