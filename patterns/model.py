@@ -27,6 +27,9 @@ class SurfaceKind(str, Enum):
     PLANE = "plane"
     CYLINDER = "cylinder"
     CONE = "cone"
+    GENERAL_CONE = "general cone"
+    """Straight lines from one point (the apex, ``origin``) to a curve (the
+    ``directrix``): an oblique cone, such as the corners of a square-to-round."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,6 +57,8 @@ class Surface:
     axis: np.ndarray
     radius: float = 0.0
     semi_angle: float = 0.0
+    directrix: np.ndarray | None = None
+    """General cone: (k, 3) points along the curve the lines from the apex end on, in order."""
 
 
 @dataclass(frozen=True, eq=False)

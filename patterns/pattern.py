@@ -85,23 +85,40 @@ class FlatPanel:
         size = float(np.ptp(uv, axis=0).max()) * 4 + 1.0
         lines = []
         if surface.kind is SurfaceKind.CYLINDER:
-            x0, x1 = uv[:, 0].min(), uv[:, 0].max()
+            from .flatten import flat_direction
+
+            along = flat_direction(self.vertices, self.faces, uv, surface.axis)  # the rulings' direction
+            across = np.array([along[1], -along[0]])
+            w = uv @ across
+            x0, x1 = w.min(), w.max()
             n = max(int(round((x1 - x0) / spacing)), 1)
             step = (x1 - x0) / n
             turn = np.degrees(step / self._radius())
             for k in range(1, n):
-                x = x0 + k * step
-                lines.append((shapely.LineString([(x, -size), (x, size)]), turn))
+                base = (x0 + k * step) * across
+                lines.append((shapely.LineString([base - size * along, base + size * along]), turn))
         else:
-            r = np.hypot(uv[:, 0], uv[:, 1])
-            theta = np.unwrap(np.arctan2(uv[self.loops[0], 1], uv[self.loops[0], 0]))
-            t0, t1 = theta.min(), theta.max()
-            n = max(int(round((t1 - t0) * r.max() / spacing)), 1)
-            step = (t1 - t0) / n
-            turn = np.degrees(step / abs(np.sin(surface.semi_angle)))
-            for k in range(1, n):
-                t = t0 + k * step
-                lines.append((shapely.LineString([(0.0, 0.0), (size * np.cos(t), size * np.sin(t))]), turn))
+            apex3d = surface.origin if surface.kind is SurfaceKind.GENERAL_CONE else \
+                surface.origin - surface.radius / np.tan(surface.semi_angle) * surface.axis
+            s3 = np.linalg.norm(self.vertices - apex3d, axis=1)
+            # The apex in the plane: the point at each vertex's 3D distance from the apex
+            # (a development keeps it), least squares: 2 uv.a - |a|^2 = |uv|^2 - s^2.
+            lhs = np.column_stack([2 * uv, -np.ones(len(uv))])
+            sol = np.linalg.lstsq(lhs, (uv * uv).sum(axis=1) - s3 * s3, rcond=None)[0]
+            apex = sol[:2]
+            if surface.kind is SurfaceKind.CONE:
+                rel = uv - apex
+                theta = np.unwrap(np.arctan2(rel[self.loops[0], 1], rel[self.loops[0], 0]))
+                t0, t1 = theta.min(), theta.max()
+                r = np.hypot(rel[:, 0], rel[:, 1])
+                n = max(int(round((t1 - t0) * r.max() / spacing)), 1)
+                step = (t1 - t0) / n
+                turn = np.degrees(step / abs(np.sin(surface.semi_angle)))
+                for k in range(1, n):
+                    t = t0 + k * step
+                    lines.append((shapely.LineString([apex, apex + size * np.array([np.cos(t), np.sin(t)])]), turn))
+            else:
+                lines = self._general_cone_rulings(surface, apex, spacing, size)
         out = []
         for line, turn in lines:
             part = line.intersection(polygon)
@@ -111,6 +128,36 @@ class FlatPanel:
                 a, b = np.asarray(seg.coords)[[0, -1]]
                 a, b = self.place([a, b])
                 out.append((a, b, float(turn)))
+        return out
+
+    def _general_cone_rulings(self, surface, apex, spacing, size):
+        """The classic triangulation lines of an oblique cone: apex to points along the
+        directrix ``spacing`` mm apart (3D), each with the fold angle between the flat
+        facets on either side of it."""
+        import shapely
+
+        d3 = surface.directrix
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(d3, axis=0), axis=1))])
+        n = max(int(round(arc[-1] / spacing)), 1)
+        marks = np.linspace(0.0, arc[-1], n + 1)
+        pts = np.column_stack([np.interp(marks, arc, d3[:, k]) for k in range(3)])
+        # Flat positions of the marks: on the panel's outline, by its 3D polyline.
+        loop = self.loops[0]
+        ring3, ring2 = self.vertices[np.r_[loop, loop[:1]]], self.flattening.uv[np.r_[loop, loop[:1]]]
+        a, b = ring3[:-1], ring3[1:]
+        out = []
+        apex3d = surface.origin
+        for k in range(1, n):
+            p = pts[k]
+            ab = b - a
+            t = np.clip(((p - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
+            j = int(np.argmin(np.linalg.norm(a + t[:, None] * ab - p, axis=1)))
+            flat = ring2[j] + t[j] * (ring2[j + 1] - ring2[j])
+            n1 = np.cross(pts[k - 1] - apex3d, p - apex3d)
+            n2 = np.cross(p - apex3d, pts[k + 1] - apex3d)
+            fold = np.degrees(np.arccos(np.clip(n1 @ n2 / (np.linalg.norm(n1) * np.linalg.norm(n2)), -1.0, 1.0)))
+            direction = (flat - apex) / max(np.linalg.norm(flat - apex), 1e-300)
+            out.append((shapely.LineString([apex, flat + 1e-6 * size * direction]), float(fold)))
         return out
 
     def _radius(self) -> float:

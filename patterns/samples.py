@@ -14,6 +14,11 @@ names in ``samples/`` to them (``samples/make_cad.py`` writes those files, and
   the apex.
 * ``hull_panel`` -- a curved boat-hull (or facade) panel, 1200 x 600 mm, doubly
   curved: one B-spline face through a 5 x 4 grid of points.
+* ``square_to_round`` -- the classic sheet-metal square-to-round transition: a
+  500 x 500 mm square at z = 0 to a 350 mm circle at z = 400, made of four
+  planar triangles (a side of the square and the circle point facing it) and
+  four oblique cones (a corner of the square and a quarter of the circle),
+  each exactly developable.
 * ``rolled_cylinder`` -- a rolled shell, 500 mm across and 500 mm high: one
   cylindrical face closed by its seam line (sheet metal: its blank is a
   rectangle, 2 pi times the neutral radius long).
@@ -23,7 +28,9 @@ from __future__ import annotations
 
 from math import pi
 
-__all__ = ["SAMPLES", "cup", "duct_transition", "hopper", "hull_panel", "rolled_cylinder"]
+import numpy as np
+
+__all__ = ["SAMPLES", "cup", "duct_transition", "hopper", "hull_panel", "rolled_cylinder", "square_to_round"]
 
 
 def duct_transition():
@@ -80,6 +87,32 @@ def hull_panel():
     return Face.make_surface_from_array_of_points(rows, tol=1e-4)
 
 
+def square_to_round(side: float = 500.0, diameter: float = 350.0, height: float = 400.0):
+    """Classic square-to-round: four planar triangles and four oblique cones, sewn."""
+    from build123d import CenterArc, Face, Shell, Vector, Vertex, Wire
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+
+    half, r = side / 2.0, diameter / 2.0
+    corners = [Vector(-half, -half, 0), Vector(half, -half, 0), Vector(half, half, 0), Vector(-half, half, 0)]
+    # The circle point facing side k (from corner k to corner k + 1).
+    facing = [Vector(r * np.cos(np.radians(-90 + 90 * k)), r * np.sin(np.radians(-90 + 90 * k)), height)
+              for k in range(4)]
+    sewing = BRepBuilderAPI_Sewing(1e-6)
+    for k in range(4):
+        sewing.Add(Face(Wire.make_polygon([corners[k], corners[(k + 1) % 4], facing[k]], close=True)).wrapped)
+        # The corner cone: straight lines from corner k + 1 to the quarter circle
+        # between the points facing sides k and k + 1.
+        sweep = BRepOffsetAPI_ThruSections(False, True)
+        sweep.AddVertex(Vertex(corners[(k + 1) % 4]).wrapped)
+        sweep.AddWire(Wire([CenterArc((0, 0, height), r, -90 + 90 * k, 90)]).wrapped)
+        sweep.Build()
+        for face in Shell(sweep.Shape()).faces():
+            sewing.Add(face.wrapped)
+    sewing.Perform()
+    return Shell(sewing.SewedShape())
+
+
 def rolled_cylinder():
     """Lateral surface of a cylinder: radius 250, height 500 (the inside skin of a rolled shell)."""
     from build123d import Shell, Solid
@@ -94,4 +127,5 @@ SAMPLES = {
     "cup.step": cup,
     "hull_panel.step": hull_panel,
     "rolled_cylinder.step": rolled_cylinder,
+    "square_to_round.step": square_to_round,
 }

@@ -261,17 +261,20 @@ class _Development:
         self.y = self.y + np.linspace(0.0, 1e-9 * span, n)
 
     def curvature(self) -> float:
-        """Largest normal curvature seen between neighbouring samples, 1/mm (0 if flat)."""
+        """Normal curvature between neighbouring samples, 1/mm (0 if flat): the 95th
+        percentile, so that a point where it has no bound (a cone's apex) does not
+        make the whole face fine."""
         k = []
+        size = float(np.ptp(self.points.reshape(-1, 3), axis=0).max())
         for axis in (0, 1):
             dn = np.diff(self.normals, axis=axis)
             dp = np.diff(self.points, axis=axis)
             ang = np.linalg.norm(dn, axis=2)
             dist = np.linalg.norm(dp, axis=2)
-            ok = np.isfinite(ang) & (dist > 0)
+            ok = np.isfinite(ang) & (dist > 1e-6 * size)
             if ok.any():
-                k.append(float(np.max(ang[ok] / dist[ok])))
-        return max(k) if k else 0.0
+                k.append((ang[ok] / dist[ok]).ravel())
+        return float(np.percentile(np.concatenate(k), 95)) if k else 0.0
 
     def forward(self, uv: np.ndarray) -> np.ndarray:
         """(k, 2) parameters -> (k, 2) development coordinates, mm."""
@@ -709,7 +712,7 @@ class _ShapeMesher:
             surface = param = None
             if len(members) == 1:
                 k = members[0]
-                surface = surface_of(self.surfaces[k], self.faces[k])
+                surface = surface_of(self.surfaces[k], self.faces[k], self.devs[k])
                 if surface is not None:
                     param = meshes[k].param[fv[first[order]] - offsets[k]]
             panels.append(Panel(label, v, f, tuple(loops), tuple(members), surface=surface, param=param))
@@ -733,13 +736,17 @@ class _ShapeMesher:
         return panels, seams
 
 
-def surface_of(surface, face):
-    """The analytic surface of a face, when it is a plane, a cylinder or a cone; else None."""
+def surface_of(surface, face, dev=None):
+    """The developable surface of a face: a plane, a cylinder, a cone, or any surface
+    swept by straight lines from one point (an oblique cone, as in a square-to-round
+    transition); else None."""
     from OCP.GeomAbs import GeomAbs_Cone, GeomAbs_Cylinder, GeomAbs_Plane
 
     from .model import Surface, SurfaceKind
 
     kind = surface.GetType()
+    if kind not in (GeomAbs_Plane, GeomAbs_Cylinder, GeomAbs_Cone):
+        return _general_cone(surface, dev) if dev is not None else None
     if kind == GeomAbs_Plane:
         ax, extra = surface.Plane().Position(), {}
         kind = SurfaceKind.PLANE
@@ -759,6 +766,49 @@ def surface_of(surface, face):
 
     return Surface(kind=kind, origin=vec(ax.Location()), x_dir=vec(ax.XDirection()), y_dir=vec(ax.YDirection()),
                    axis=vec(ax.Direction()), **extra)
+
+
+def _general_cone(surface, dev):
+    """A surface made of straight lines through one point (apex), recognised on its
+    parameter grid: one side of the grid collapses to a point and every grid line
+    from there is straight.  Returns its apex and a dense sample of the opposite
+    boundary (the directrix), or None."""
+    from .model import Surface, SurfaceKind
+
+    pts = dev.points  # (nv, nu, 3): rows along u at fixed v
+    size = float(np.ptp(pts.reshape(-1, 3), axis=0).max())
+    if size <= 0:
+        return None
+    sides = {"v0": (pts[0], pts), "v1": (pts[-1], pts[::-1]),
+             "u0": (pts[:, 0], pts.transpose(1, 0, 2)), "u1": (pts[:, -1], pts.transpose(1, 0, 2)[::-1])}
+    for key, (edge, grid) in sides.items():
+        if np.ptp(edge, axis=0).max() > 1e-9 * size:
+            continue
+        apex = edge.mean(axis=0)
+        # grid[j] are the points at the j-th line parallel to the apex side; lines
+        # from the apex run across j.  Straight: every point on its apex-to-far line.
+        far = grid[-1]
+        line = far - apex
+        length = np.linalg.norm(line, axis=1)
+        if np.any(length <= 1e-9 * size):
+            return None
+        unit = line / length[:, None]
+        rel = grid - apex
+        off = rel - (rel * unit[None]).sum(axis=2)[..., None] * unit[None]
+        if np.abs(off).max() > 1e-7 * size:
+            return None
+        # The directrix: the far boundary, sampled densely on the surface.
+        n = 2001
+        if key in ("v0", "v1"):
+            u = np.linspace(dev.u[0], dev.u[-1], n)
+            v = np.full(n, dev.v[-1] if key == "v0" else dev.v[0])
+        else:
+            v = np.linspace(dev.v[0], dev.v[-1], n)
+            u = np.full(n, dev.u[-1] if key == "u0" else dev.u[0])
+        directrix = _evaluate(surface, np.column_stack([u, v]))
+        z = np.zeros(3)
+        return Surface(kind=SurfaceKind.GENERAL_CONE, origin=apex, x_dir=z, y_dir=z, axis=z, directrix=directrix)
+    return None
 
 
 class _FaceMesh:

@@ -105,6 +105,8 @@ def develop(surface, points: np.ndarray, param: np.ndarray | None = None, *, off
         mirrors if its triangles come out clockwise.
     """
     points = np.asarray(points, dtype=np.float64)
+    if surface.kind is SurfaceKind.GENERAL_CONE:
+        return _develop_general_cone(surface, points)
     if surface.kind is SurfaceKind.PLANE:
         rel = points - surface.origin
         return np.column_stack([rel @ surface.x_dir, rel @ surface.y_dir])
@@ -125,3 +127,36 @@ def develop(surface, points: np.ndarray, param: np.ndarray | None = None, *, off
     s = np.hypot(r, h - apex_h)
     theta = angle * abs(sin_a)
     return np.column_stack([s * np.cos(theta), s * np.sin(theta)])
+
+
+def _develop_general_cone(surface, points: np.ndarray) -> np.ndarray:
+    """Polar coordinates about the apex: the distance from it, and the angle turned
+    so far by the line from the apex -- the length of the line's direction's path
+    on the unit sphere, which the development keeps."""
+    apex = surface.origin
+    table = surface.directrix - apex
+    table = table / np.linalg.norm(table, axis=1, keepdims=True)
+    step = np.arccos(np.clip((table[1:] * table[:-1]).sum(axis=1), -1.0, 1.0))
+    theta = np.concatenate([[0.0], np.cumsum(step)])
+    rel = points - apex
+    s = np.linalg.norm(rel, axis=1)
+    out = np.zeros((len(points), 2))
+    at_apex = s <= 1e-12 * max(float(s.max()), 1.0)
+    u = rel[~at_apex] / s[~at_apex, None]
+    # Nearest sample of the directrix's direction, then linear between neighbours.
+    k = np.argmax(u @ table.T, axis=1)
+    k = np.clip(k, 1, len(table) - 2)
+    best = np.empty(len(k))
+    for shift in (-1, 0):
+        a, b = table[k + shift], table[k + shift + 1]
+        ab = b - a
+        t = np.clip(((u - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
+        d = np.linalg.norm(a + t[:, None] * ab - u, axis=1)
+        value = theta[k + shift] + t * step[k + shift]
+        if shift == -1:
+            best_d, best = d, value
+        else:
+            better = d < best_d
+            best = np.where(better, value, best)
+    out[~at_apex] = np.column_stack([s[~at_apex] * np.cos(best), s[~at_apex] * np.sin(best)])
+    return out
