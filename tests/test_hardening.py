@@ -35,6 +35,25 @@ def _mesh_bytes(suffix):
     return data
 
 
+def _cad_bytes(suffix):
+    """The cup sample written as IGES or BREP, to truncate."""
+    import build123d as bd
+    from OCP.IGESControl import IGESControl_Writer
+
+    shape = bd.import_step(SAMPLES / "cup.step")
+    path = Path(os.environ.get("TMPDIR", "/tmp")) / f"_hardening_source{suffix}"
+    if suffix == ".igs":
+        writer = IGESControl_Writer("MM", 1)
+        writer.AddShape(shape.wrapped)
+        writer.ComputeModel()
+        writer.Write(str(path))
+    else:
+        bd.export_brep(shape, path)
+    data = path.read_bytes()
+    path.unlink()
+    return data
+
+
 FILES = {
     # name: (bytes, error class, words in the message)
     "empty.step": (b"", CadError, "empty"),
@@ -50,6 +69,8 @@ FILES = {
     "noise.ply": (_noise(5000), InputError, ""),
     "truncated.step": ((SAMPLES / "cup.step").read_bytes()[:2000], CadError, ""),
     "truncated.stl": (_mesh_bytes(".stl")[:1000], InputError, ""),
+    "truncated.igs": (_cad_bytes(".igs")[:3000], CadError, "IGES"),
+    "truncated.brep": (_cad_bytes(".brep")[:3000], CadError, "BREP"),
     "truncated.ply": (_mesh_bytes(".ply")[:600], InputError, ""),
     "nan.obj": (b"v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n", InputError, "NaN"),
     "inf.obj": (b"v 0 0 0\nv 1 0 0\nv inf 1 0\nf 1 2 3\n", InputError, "NaN or infinite"),
