@@ -21,7 +21,7 @@ import shapely
 from .measure import folded_faces
 
 __all__ = ["REPORT_SCHEMA", "Code", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
-           "boundary_crossings", "check", "overlap_verdict"]
+           "boundary_crossings", "check", "crossing_segments", "overlap_verdict"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -404,6 +404,29 @@ def _ro(a) -> np.ndarray:
     return a
 
 
+def crossing_segments(uv: np.ndarray, loops):
+    """Pairs of flat boundary segments that touch or cross, neighbours along a loop left out.
+
+    Returns
+    -------
+    lines : (s,) shapely LineStrings
+        Every boundary segment, loop after loop.
+    pair : (s, 2) int64
+        Each segment's two vertex indices.
+    i, j : (c,) int64
+        Indices into ``lines`` of the segments that meet, ``i < j``.
+    """
+    starts = np.concatenate(loops)
+    ends = np.concatenate([np.roll(loop, -1) for loop in loops])
+    lines = shapely.linestrings(np.stack([uv[starts], uv[ends]], axis=1))
+    i, j = shapely.STRtree(lines).query(lines, predicate="intersects")
+    keep = i < j
+    i, j = i[keep], j[keep]
+    pair = np.stack([starts, ends], axis=1)
+    adjacent = (pair[i][:, :, None] == pair[j][:, None, :]).any(axis=(1, 2))
+    return lines, pair, i[~adjacent], j[~adjacent]
+
+
 def boundary_crossings(uv: np.ndarray, loops) -> list[tuple[int, int, np.ndarray]]:
     """Where flat boundary segments cross.
 
@@ -419,16 +442,8 @@ def boundary_crossings(uv: np.ndarray, loops) -> list[tuple[int, int, np.ndarray
         crossing itself), with the crossing points.  Segments that share a
         vertex are not counted as crossing there.
     """
-    starts = np.concatenate(loops)
-    ends = np.concatenate([np.roll(loop, -1) for loop in loops])
     loop_of = np.concatenate([np.full(len(loop), i) for i, loop in enumerate(loops)])
-    lines = shapely.linestrings(np.stack([uv[starts], uv[ends]], axis=1))
-    i, j = shapely.STRtree(lines).query(lines, predicate="intersects")
-    keep = i < j
-    i, j = i[keep], j[keep]
-    pair = np.stack([starts, ends], axis=1)
-    adjacent = (pair[i][:, :, None] == pair[j][:, None, :]).any(axis=(1, 2))
-    i, j = i[~adjacent], j[~adjacent]
+    lines, _, i, j = crossing_segments(uv, loops)
     out = {}
     for a, b in zip(i, j):
         key = (int(min(loop_of[a], loop_of[b])), int(max(loop_of[a], loop_of[b])))

@@ -164,7 +164,7 @@ def _parser() -> argparse.ArgumentParser:
 # --------------------------------------------------------------------------- #
 
 
-def _load(args, *, progress=None):
+def _load(args):
     from .load import CAD_SUFFIXES, MESH_SUFFIXES, load, mesh_model, read_mesh
 
     path = args.input

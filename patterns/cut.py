@@ -23,14 +23,9 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from .errors import MeshTopologyError
-from .mesh import check_boundary_vertices, edge_tables, trace_loops
+from .mesh import _readonly, check_boundary_vertices, edge_tables, trace_loops
 
 __all__ = ["Cut", "cut_along", "cut_to_disk", "pieces"]
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, eq=False)

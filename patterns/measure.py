@@ -103,7 +103,11 @@ def principal_stretches(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray)
     (m, 2) float64
         ``sigma1 >= sigma2 >= 0`` (dimensionless); 1 is no stretch.
     """
-    alpha, beta = affine_coefficients(vertices, faces, uv)
+    return _stretches(*affine_coefficients(vertices, faces, uv))
+
+
+def _stretches(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """``(m, 2)`` principal stretches ``|alpha| + |beta|``, ``||alpha| - |beta||``."""
     a, b = np.abs(alpha), np.abs(beta)
     return np.stack([a + b, np.abs(a - b)], axis=1)
 
@@ -302,8 +306,7 @@ def triangle_strains(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) ->
     TriangleStrain
     """
     alpha, beta = affine_coefficients(vertices, faces, uv)
-    a, b = np.abs(alpha), np.abs(beta)
-    stretch = np.stack([a + b, np.abs(a - b)], axis=1)
+    stretch = _stretches(alpha, beta)
     strain = stretch - 1.0
     first = np.abs(strain[:, 0]) >= np.abs(strain[:, 1])
     dominant = np.where(first, strain[:, 0], strain[:, 1])

@@ -40,6 +40,7 @@ import numpy as np
 import scipy.sparse as sp
 import shapely
 
+from ..check import crossing_segments
 from ..errors import InputError
 from ..measure import local_coordinates, signed_areas
 from ..mesh import Connectivity
@@ -488,15 +489,7 @@ def _boundary_crossings(uv: np.ndarray, loops):
     rings = [uv[loop] for loop in loops]
     if shapely.is_valid(shapely.Polygon(rings[0], rings[1:])):
         return None
-    starts = np.concatenate(loops)
-    ends = np.concatenate([np.roll(loop, -1) for loop in loops])
-    lines = shapely.linestrings(np.stack([uv[starts], uv[ends]], axis=1))
-    i, j = shapely.STRtree(lines).query(lines, predicate="intersects")
-    keep = i < j
-    i, j = i[keep], j[keep]
-    pair = np.stack([starts, ends], axis=1)
-    adjacent = (pair[i][:, :, None] == pair[j][:, None, :]).any(axis=(1, 2))
-    i, j = i[~adjacent], j[~adjacent]
+    _, pair, i, j = crossing_segments(uv, loops)
     return np.unique(np.concatenate([pair[i].ravel(), pair[j].ravel()]))
 
 
