@@ -23,7 +23,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from .errors import MeshTopologyError
-from .mesh import _readonly, check_boundary_vertices, edge_tables, trace_loops
+from .mesh import _readonly, check_boundary_vertices, edge_lengths, edge_tables, trace_loops
 
 __all__ = ["Cut", "cut_along", "cut_to_disk", "pieces"]
 
@@ -157,7 +157,7 @@ def cut_to_disk(vertices: np.ndarray, faces: np.ndarray, *, name: str = "mesh") 
 
 def _edge_graph(vertices, t, keep):
     e = t.edges[keep]
-    w = np.linalg.norm(vertices[e[:, 1]] - vertices[e[:, 0]], axis=1)
+    w = edge_lengths(vertices, e)
     n = len(vertices)
     return sp.coo_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), shape=(n, n)).tocsr()
 

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .mesh import edge_lengths, side_vectors
+
 __all__ = [
     "Distortion",
     "TriangleStrain",
@@ -55,17 +57,16 @@ def local_coordinates(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
         Corner ``k`` of face ``f`` is ``x + iy`` in the face's frame, same unit as
         ``vertices``.
     """
-    p = vertices[faces]
-    a = p[:, 1] - p[:, 0]
-    b = p[:, 2] - p[:, 0]
-    n = np.cross(a, b)
-    n /= np.linalg.norm(n, axis=1, keepdims=True)
-    x = np.cross(n, b)
-    x /= np.linalg.norm(x, axis=1, keepdims=True)
-    y = np.cross(n, x)
+    # In that frame Y = N x X = -B / |B| and X = (N x B) / |B|, so
+    # A.X = -|A x B| / |B|, A.Y = -A.B / |B|, B.X = 0 and B.Y = -|B|.
+    (ax, ay, az), (bx, by, bz) = side_vectors(vertices, faces)
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    cross = np.sqrt(cx * cx + cy * cy + cz * cz)
+    blen = np.sqrt(bx * bx + by * by + bz * bz)
     z = np.zeros((len(faces), 3), dtype=np.complex128)
-    z[:, 1] = np.einsum("ij,ij->i", a, x) + 1j * np.einsum("ij,ij->i", a, y)
-    z[:, 2] = np.einsum("ij,ij->i", b, x) + 1j * np.einsum("ij,ij->i", b, y)
+    z[:, 1].real = -cross / blen
+    z[:, 1].imag = -(ax * bx + ay * by + az * bz) / blen
+    z[:, 2].imag = -blen
     return z
 
 
@@ -149,7 +150,7 @@ def edge_strain(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, edge
     """
     if edges is None:
         edges = _unique_edges(faces)
-    l3 = np.linalg.norm(vertices[edges[:, 1]] - vertices[edges[:, 0]], axis=1)
+    l3 = edge_lengths(vertices, edges)
     l2 = np.linalg.norm(uv[edges[:, 1]] - uv[edges[:, 0]], axis=1)
     return np.abs(l2 / l3 - 1.0)
 

@@ -27,8 +27,10 @@ __all__ = [
     "as_mesh_arrays",
     "boundary_loops",
     "check_boundary_vertices",
+    "edge_lengths",
     "edge_tables",
     "face_areas",
+    "side_vectors",
     "trace_loops",
     "validate_mesh",
 ]
@@ -140,12 +142,57 @@ def face_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     -------
     (m,) float64, in the square of the vertices' unit (unsigned).
     """
-    p = vertices[faces]
-    a = p[:, 1] - p[:, 0]
-    b = p[:, 2] - p[:, 0]
-    if vertices.shape[1] == 2:
-        return 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-    return 0.5 * np.linalg.norm(np.cross(a, b), axis=1)
+    a, b = side_vectors(vertices, faces)
+    if len(a) == 2:
+        return 0.5 * np.abs(a[0] * b[1] - a[1] * b[0])
+    cx, cy, cz = a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
+    return 0.5 * np.sqrt(cx * cx + cy * cy + cz * cz)
+
+
+def side_vectors(points: np.ndarray, faces: np.ndarray) -> tuple[list, list]:
+    """The sides ``p1 - p0`` and ``p2 - p0`` of every triangle, coordinate by coordinate.
+
+    Gathering one coordinate column at a time is several times faster than
+    gathering ``(m, 3, d)`` blocks.
+
+    Parameters
+    ----------
+    points : (n, d) float64
+    faces : (m, 3) int64
+
+    Returns
+    -------
+    a, b : list of d (m,) float64
+    """
+    f0, f1, f2 = faces[:, 0], faces[:, 1], faces[:, 2]
+    a, b = [], []
+    for k in range(points.shape[1]):
+        c = np.ascontiguousarray(points[:, k])
+        c0 = c.take(f0)
+        a.append(c.take(f1) - c0)
+        b.append(c.take(f2) - c0)
+    return a, b
+
+
+def edge_lengths(points: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Lengths of the segments ``points[edges[:, 0]]``--``points[edges[:, 1]]``.
+
+    Parameters
+    ----------
+    points : (n, d) float64
+    edges : (e, 2) int64
+
+    Returns
+    -------
+    (e,) float64, in the points' unit.
+    """
+    e0, e1 = edges[:, 0], edges[:, 1]
+    total = np.zeros(len(edges))
+    for k in range(points.shape[1]):
+        c = np.ascontiguousarray(points[:, k])
+        d = c.take(e1) - c.take(e0)
+        total += d * d
+    return np.sqrt(total)
 
 
 @dataclass(frozen=True, eq=False)

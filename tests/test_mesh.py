@@ -120,3 +120,25 @@ def test_holes_give_one_loop_each_with_the_outer_loop_first():
     _, _, conn = validate_mesh(v3[used], remap[f])
     assert len(conn.loops) == 3
     assert len(conn.loops[0]) == 6 * round(np.sqrt(3000 / 6))  # the rim ring
+
+
+def test_column_helpers_match_the_row_formulas():
+    from patterns.measure import local_coordinates
+    from patterns.mesh import edge_lengths, face_areas, side_vectors
+
+    v, f = surfaces.ellipsoid_cup(n_faces=600)
+    v, f, conn = validate_mesh(v, f)
+    e = conn.edges
+    assert np.allclose(edge_lengths(v, e), np.linalg.norm(v[e[:, 1]] - v[e[:, 0]], axis=1), rtol=1e-14, atol=0)
+    a, b = side_vectors(v, f)
+    assert np.array_equal(np.column_stack(a), v[f[:, 1]] - v[f[:, 0]])
+    assert np.array_equal(np.column_stack(b), v[f[:, 2]] - v[f[:, 0]])
+    cross = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    assert np.allclose(face_areas(v, f), 0.5 * np.linalg.norm(cross, axis=1), rtol=1e-13, atol=0)
+    # The local frames are isometric copies: the same three side lengths, counter-clockwise.
+    z = local_coordinates(v, f)
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        assert np.allclose(np.abs(z[:, j] - z[:, i]), np.linalg.norm(v[f[:, j]] - v[f[:, i]], axis=1),
+                           rtol=1e-12, atol=0)
+    assert np.all((np.conj(z[:, 1]) * z[:, 2]).imag > 0)
+    assert np.allclose(0.5 * (np.conj(z[:, 1]) * z[:, 2]).imag, face_areas(v, f), rtol=1e-12, atol=0)

@@ -7,8 +7,8 @@ import patterns
 from patterns import surfaces
 from patterns.errors import InputError
 from patterns.flatten.embed import lscm, tutte_embedding
-from patterns.load import read_mesh
 from patterns.flatten.relax import best_scale, flip_free_steps
+from patterns.load import read_mesh
 from patterns.mesh import validate_mesh
 
 from .helpers import independent_one_to_one, rigid_fit_residual
@@ -203,3 +203,31 @@ def test_heads_relax_far_below_their_conformal_start(name):
     # 0.83 and 0.78, libigl ARAP 0.45 (264 folded) and 0.53 (no fold).
     assert r.distortion.edge_strain_rms < 0.55 * start_rms
     assert r.distortion.edge_strain_rms < 0.45
+
+
+def test_refactorisation_reusing_the_ordering_solves_the_same_system():
+    """The relaxation refactorises its preconditioner with the first factor's
+    elimination order; the solution must be the one of a fresh factorisation."""
+    import scipy.sparse as sp
+
+    from patterns.flatten.embed import factorize
+    from patterns.flatten.relax import _laplacian
+
+    v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=3000)
+    v, f, conn = validate_mesh(v, f)
+    e = conn.edges
+    n = len(v)
+    w = 1.0 / np.linalg.norm(v[e[:, 1]] - v[e[:, 0]], axis=1) ** 2
+    first = factorize(_laplacian(n, e, w, anchor=float(w.mean())))
+    rng = np.random.default_rng(5)
+    w2 = w * rng.uniform(1.0, 50.0, size=len(w))  # other numbers, the same pattern
+    matrix = _laplacian(n, e, w2, anchor=float(w.mean()))
+    b = rng.normal(size=(n, 2))
+    reused = factorize(matrix, like=first).solve(b)
+    fresh = factorize(matrix).solve(b)
+    assert np.allclose(reused, fresh, rtol=0, atol=1e-9 * np.abs(fresh).max())
+    assert np.allclose(sp.csr_matrix(matrix) @ reused, b, rtol=0, atol=1e-8 * np.abs(b).max())
+    # The Laplacian itself: rows sum to zero except the anchored vertex 0.
+    row_sums = np.asarray(matrix.sum(axis=1)).ravel()
+    assert row_sums[0] == pytest.approx(w.mean(), rel=1e-12)
+    assert np.abs(row_sums[1:]).max() < 1e-9 * w2.max()

@@ -221,7 +221,7 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
     if pins is not None:
         start = align_to_pins(start, *pins)  # a rigid motion: still one-to-one
     result = relax(v, f, conn, start, pins=pins, barrier=barrier, max_iterations=max_iterations, tolerance=tolerance,
-                   progress=progress)
+                   progress=progress, local=z)
     uv = np.array(result.uv)
     return Flattening(
         uv=_readonly(uv),

@@ -20,17 +20,58 @@ import scipy.sparse.linalg as spla
 
 from ..mesh import Connectivity
 
-__all__ = ["factorize", "lscm", "tutte_embedding"]
+__all__ = ["Factor", "factorize", "lscm", "tutte_embedding"]
 
 
-def factorize(matrix: sp.spmatrix):
+class Factor:
+    """A sparse LU factorisation of a symmetric positive definite ``(n, n)`` matrix.
+
+    Attributes
+    ----------
+    order : (n,) int64
+        The fill-reducing elimination order (row/column ``order[k]`` is
+        eliminated ``k``-th); a later matrix of the same pattern can reuse it
+        (:func:`factorize`'s ``like``).
+    """
+
+    def __init__(self, lu, order: np.ndarray, permuted: bool):
+        self._lu, self.order, self._permuted = lu, order, permuted
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """``A^-1 b`` for ``b`` of shape ``(n,)`` or ``(n, k)``."""
+        if not self._permuted:
+            return self._lu.solve(b)
+        x = np.empty_like(b)
+        x[self.order] = self._lu.solve(b[self.order])
+        return x
+
+
+def factorize(matrix: sp.spmatrix, *, like: Factor | None = None) -> Factor:
     """Sparse LU of a symmetric positive definite matrix, minimum-degree ordered.
 
-    Returns the ``scipy.sparse.linalg.SuperLU`` object (``.solve`` takes
-    ``(k,)`` or ``(k, r)`` right-hand sides).
+    Parameters
+    ----------
+    matrix : (n, n) sparse
+    like : Factor, optional
+        A factorisation of a matrix with the same sparsity pattern: its
+        elimination order is reused, so only the numbers are factorised (the
+        relaxation refactorises its preconditioner this way).
+
+    Returns
+    -------
+    Factor
     """
-    return spla.splu(sp.csc_matrix(matrix), permc_spec="MMD_AT_PLUS_A",
-                     options={"SymmetricMode": True}, diag_pivot_thresh=0.0)
+    # Panels of 4 columns (SuperLU's default is 10) factorise these mesh
+    # Laplacians about a fifth faster; the factor itself is the same.
+    options = {"SymmetricMode": True}
+    if like is None:
+        lu = spla.splu(sp.csc_matrix(matrix), permc_spec="MMD_AT_PLUS_A", panel_size=4, options=options,
+                       diag_pivot_thresh=0.0)
+        return Factor(lu, np.argsort(lu.perm_c), False)
+    order = like.order
+    permuted = sp.csr_matrix(matrix)[order][:, order].tocsc()
+    lu = spla.splu(permuted, permc_spec="NATURAL", panel_size=4, options=options, diag_pivot_thresh=0.0)
+    return Factor(lu, order, True)
 
 
 def tutte_embedding(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity) -> np.ndarray:
@@ -103,17 +144,18 @@ def lscm(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, *, local: 
     weight = np.stack([z[:, 2] - z[:, 1], z[:, 0] - z[:, 2], z[:, 1] - z[:, 0]], axis=1)
     weight /= np.sqrt(np.abs((np.conj(z[:, 1]) * z[:, 2]).imag))[:, None]
     rows = np.repeat(np.arange(m), 3)
-    cols = faces.ravel()
+    cu = 2 * faces.ravel()  # unknowns interleaved, u0 v0 u1 v1 ...: a tighter factor
+    cv = cu + 1
     a, b = weight.real.ravel(), weight.imag.ravel()
     # Rows 0..m-1: real part (a u - b v); rows m..2m-1: imaginary part (a v + b u).
     system = sp.coo_matrix(
-        (np.r_[a, -b, b, a], (np.r_[rows, rows, rows + m, rows + m], np.r_[cols, cols + n, cols, cols + n])),
+        (np.r_[a, -b, b, a], (np.r_[rows, rows, rows + m, rows + m], np.r_[cu, cv, cu, cv])),
         shape=(2 * m, 2 * n),
     ).tocsc()
     loop = conn.loops[0]
     p0 = loop[np.argmax(np.linalg.norm(vertices[loop] - vertices[loop[0]], axis=1))]
     p1 = loop[np.argmax(np.linalg.norm(vertices[loop] - vertices[p0], axis=1))]
-    fixed = np.array([p0, p1, p0 + n, p1 + n])
+    fixed = np.array([2 * p0, 2 * p1, 2 * p0 + 1, 2 * p1 + 1])
     values = np.array([0.0, np.linalg.norm(vertices[p1] - vertices[p0]), 0.0, 0.0])
     free = np.ones(2 * n, dtype=bool)
     free[fixed] = False
@@ -121,4 +163,4 @@ def lscm(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, *, local: 
     x = np.zeros(2 * n)
     x[fixed] = values
     x[free] = factorize(a_free.T @ a_free).solve(-(a_free.T @ (a_fixed @ values)))
-    return np.column_stack([x[:n], x[n:]])
+    return x.reshape(n, 2)

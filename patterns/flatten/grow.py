@@ -57,7 +57,7 @@ import numpy as np
 from scipy.sparse import coo_matrix, csgraph
 
 from ..errors import FlattenError
-from ..mesh import Connectivity
+from ..mesh import Connectivity, edge_lengths
 
 __all__ = [
     "grow_fronts",
@@ -181,7 +181,7 @@ def seed_face(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity) -> in
         distance to the nearest boundary vertex.
     """
     e = conn.edges
-    length = np.linalg.norm(vertices[e[:, 1]] - vertices[e[:, 0]], axis=1)
+    length = edge_lengths(vertices, e)
     n = conn.n_vertices
     graph = coo_matrix((length, (e[:, 0], e[:, 1])), shape=(n, n)).tocsr()
     sources = np.unique(np.concatenate(conn.loops))

@@ -43,13 +43,14 @@ import shapely
 from ..check import crossing_segments
 from ..errors import InputError
 from ..measure import local_coordinates, signed_areas
-from ..mesh import Connectivity
+from ..mesh import Connectivity, edge_lengths
 from .embed import factorize
 
 _WINDOW = 2  # iterations over which progress is judged
 _STAGE_TOLERANCE = 30.0  # a barrier stage ends at this many times the tolerance
 _REFRESH = 5  # iterations between refactorisations while the barrier is strong
 _MEMORY = 8  # L-BFGS pairs kept
+_DROP = 0.1  # the barrier weight is multiplied by this at each new stage
 _WEAKEST = 1e-5  # the last barrier stage before the stress alone
 
 __all__ = ["Relaxation", "align_to_pins", "best_scale", "flip_free_steps", "relax"]
@@ -149,7 +150,7 @@ def align_to_pins(uv: np.ndarray, index: np.ndarray, target: np.ndarray) -> np.n
 
 def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np.ndarray, *,
           pins=None, barrier: float = 1e-3, max_iterations: int = 500, tolerance: float = 1e-4,
-          progress=None) -> Relaxation:
+          progress=None, local=None) -> Relaxation:
     """Relax a one-to-one layout towards true edge lengths, keeping it one-to-one.
 
     See the module docstring for the method.
@@ -176,6 +177,9 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         (averaged over two); a barrier stage ends at 30 times this.
     progress : callable, optional
         ``progress(iteration, max_iterations)`` after each iteration.
+    local : (m, 3) complex128, optional
+        :func:`patterns.measure.local_coordinates` of the mesh, if already at
+        hand (computed otherwise).
 
     Returns
     -------
@@ -183,26 +187,24 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     """
     n = len(vertices)
     e = conn.edges
-    length = np.linalg.norm(vertices[e[:, 1]] - vertices[e[:, 0]], axis=1)
+    length = edge_lengths(vertices, e)
     uv = np.array(start, dtype=np.float64)
     floor = 1e-20 * len(length)  # RMS edge strain 1e-10: round-off level
-    if pins is None and np.sum((np.linalg.norm(uv[e[:, 1]] - uv[e[:, 0]], axis=1) / length - 1) ** 2) <= floor:
+    if pins is None and np.sum((edge_lengths(uv, e) / length - 1) ** 2) <= floor:
         uv.setflags(write=False)  # already exact (a developable part): nothing to relax
         return Relaxation(uv, 0, True)
     weight = 1.0 / length**2
-    adjacency = sp.coo_matrix((np.r_[weight, weight], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])),
-                              shape=(n, n)).tocsr()
-    laplacian = (sp.diags(np.asarray(adjacency.sum(axis=1)).ravel()) - adjacency).tocsr()
     free = np.ones(n, dtype=bool)
     if pins is None:
         # The stress does not see translations: tie vertex 0 softly.  For the
         # preconditioner only; the energy itself has no anchor term.
-        anchor = sp.coo_matrix(([float(weight.mean())], ([0], [0])), shape=(n, n))
-        system = laplacian + anchor
+        anchor = float(weight.mean())
+        system = _laplacian(n, e, weight, anchor=anchor)
         iterations = 0
     else:
         pin_index, pin_target = pins
         free[pin_index] = False
+        laplacian = _laplacian(n, e, weight)
         system = laplacian[free][:, free]
         uv, iterations = _travel_to_pins(faces, conn.loops, e, length, weight, laplacian, free, uv, pin_index,
                                          pin_target, max_iterations, progress)
@@ -211,7 +213,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
             return Relaxation(uv, iterations, False)
         uv[pin_index] = pin_target
     lu = factorize(system)
-    energy = _StressBarrier(vertices, faces, e, length)
+    energy = _StressBarrier(vertices, faces, e, length, local=local)
 
     def refactor(u, mu):
         """The Laplacian with the barrier's curvature added to its weights, factorised."""
@@ -224,10 +226,11 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
             # edges (a few squeezed triangles): not worth a factorisation.
             return lu
         w = weight * (1.0 + 0.5 * extra)
-        adj = sp.coo_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), shape=(n, n)).tocsr()
-        lap = (sp.diags(np.asarray(adj.sum(axis=1)).ravel()) - adj).tocsr()
-        lap = lap[free][:, free] if pins is not None else lap + anchor
-        return factorize(lap)
+        if pins is None:
+            lap = _laplacian(n, e, w, anchor=anchor)
+        else:
+            lap = _laplacian(n, e, w)[free][:, free]
+        return factorize(lap, like=lu)  # same pattern: the first ordering serves
 
     uv, used, converged = _quasi_newton(energy, faces, conn.loops, uv, free, lu, refactor=refactor, barrier=barrier,
                                         max_iterations=max_iterations - iterations, tolerance=tolerance,
@@ -246,12 +249,19 @@ class _StressBarrier:
     mesh then counts about as many terms as the stress, half as many as edges).
     ``|J^-1|_F**2 = |J|_F**2 / det(J)**2`` is 2 for a rigid motion and grows
     without bound as the triangle collapses.
+
+    The two terms are evaluated apart (:meth:`parts`) so that a change of
+    ``mu`` needs no new evaluation.  Coordinates are gathered column by column
+    (several times faster than gathering ``(k, 2)`` rows) and gradients
+    scattered by sparse products.
     """
 
-    def __init__(self, vertices, faces, edges, length):
+    def __init__(self, vertices, faces, edges, length, *, local=None):
         n = len(vertices)
         self.faces, self.edges, self.length = faces, edges, length
-        z = local_coordinates(vertices, faces)
+        self._e0, self._e1 = np.ascontiguousarray(edges[:, 0]), np.ascontiguousarray(edges[:, 1])
+        self._f0, self._f1, self._f2 = (np.ascontiguousarray(faces[:, k]) for k in range(3))
+        z = local_coordinates(vertices, faces) if local is None else local
         r1, r2 = z[:, 1] - z[:, 0], z[:, 2] - z[:, 0]
         # R = [[r1.x, r2.x], [r1.y, r2.y]]; G = R^-1 R^-T (symmetric).
         det_r = r1.real * r2.imag - r2.real * r1.imag
@@ -261,21 +271,25 @@ class _StressBarrier:
         area = 0.5 * np.abs(det_r)
         self.w = 0.75 * area / area.mean()
         ne, m = len(edges), len(faces)
+        self._inv_length = 1.0 / length
         # Sparse scatter matrices: per-edge and per-triangle-column gradients to vertices.
         self.edge_scatter = sp.csr_matrix((np.r_[np.ones(ne), -np.ones(ne)],
-                                           (np.r_[edges[:, 1], edges[:, 0]], np.r_[np.arange(ne), np.arange(ne)])),
+                                           (np.r_[self._e1, self._e0], np.r_[np.arange(ne), np.arange(ne)])),
                                           shape=(n, ne))
         cols = np.arange(2 * m)
         self.face_scatter = sp.csr_matrix(
             (np.r_[np.ones(2 * m), -np.ones(2 * m)],
-             (np.r_[faces[:, 1], faces[:, 2], faces[:, 0], faces[:, 0]], np.r_[cols, cols])), shape=(n, 2 * m))
+             (np.r_[self._f1, self._f2, self._f0, self._f0], np.r_[cols, cols])), shape=(n, 2 * m))
+
+    def _frames(self, u):
+        """Columns of each triangle's flat edge matrix ``P = [[a, b], [c, d]]``."""
+        x, y = u[:, 0], u[:, 1]
+        x0, y0 = x.take(self._f0), y.take(self._f0)
+        return x.take(self._f1) - x0, x.take(self._f2) - x0, y.take(self._f1) - y0, y.take(self._f2) - y0
 
     def barrier_stiffness(self, u, mu):
         """Per-triangle curvature scale of the barrier term, ``(m,)``: ``mu w 6 / sigma_min**4``."""
-        f = self.faces
-        x, y = u[:, 0], u[:, 1]
-        a, c = x[f[:, 1]] - x[f[:, 0]], y[f[:, 1]] - y[f[:, 0]]
-        b, dd = x[f[:, 2]] - x[f[:, 0]], y[f[:, 2]] - y[f[:, 0]]
+        a, b, c, dd = self._frames(u)
         det2 = (a * dd - b * c) ** 2 / self.det_r2  # det(J)**2
         norm_j = a * (a * self.g11 + b * self.g12) + b * (a * self.g12 + b * self.g22) + \
             c * (c * self.g11 + dd * self.g12) + dd * (c * self.g12 + dd * self.g22)
@@ -285,20 +299,19 @@ class _StressBarrier:
         with np.errstate(divide="ignore", over="ignore"):
             return np.minimum(mu * self.w * 6.0 / (smin2 * smin2), 1e12)
 
-    def __call__(self, u, mu):
-        """``(E, gradient (n, 2))``; ``(inf, None)`` if ``mu > 0`` and a triangle is folded."""
-        e = self.edges
-        d = u[e[:, 1]] - u[e[:, 0]]
-        dl = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2)
-        r = dl / self.length - 1.0
-        grad = self.edge_scatter @ (d * (2.0 * r / (self.length * np.maximum(dl, 1e-300)))[:, None])
-        value = float(r @ r)
-        if mu == 0:
-            return value, grad
-        f = self.faces
+    def stress(self, u):
+        """``(S, gradient (n, 2))``: the summed squared edge strain."""
         x, y = u[:, 0], u[:, 1]
-        a, c = x[f[:, 1]] - x[f[:, 0]], y[f[:, 1]] - y[f[:, 0]]  # P = [[a, b], [c, d]]
-        b, dd = x[f[:, 2]] - x[f[:, 0]], y[f[:, 2]] - y[f[:, 0]]
+        dx = x.take(self._e1) - x.take(self._e0)
+        dy = y.take(self._e1) - y.take(self._e0)
+        dl = np.sqrt(dx * dx + dy * dy)
+        r = dl * self._inv_length - 1.0
+        k = 2.0 * r * self._inv_length / np.maximum(dl, 1e-300)
+        return float(r @ r), self.edge_scatter @ np.column_stack([k * dx, k * dy])
+
+    def barrier(self, u):
+        """``(B, gradient (n, 2))`` of the barrier (``mu = 1``); ``(inf, None)`` if a triangle is folded."""
+        a, b, c, dd = self._frames(u)
         det_p = a * dd - b * c
         if not np.all(det_p > 0):
             return np.inf, None
@@ -306,15 +319,32 @@ class _StressBarrier:
         pg21, pg22 = c * self.g11 + dd * self.g12, c * self.g12 + dd * self.g22
         norm_j = a * pg11 + b * pg12 + c * pg21 + dd * pg22  # |J|^2 (times nothing: G carries R)
         s = self.det_r2 / (det_p * det_p)
-        value += mu * float(self.w @ (norm_j * s))
-        k1 = (2.0 * mu) * self.w * s
+        ws = self.w * s
+        value = float(ws @ norm_j)
+        k1 = 2.0 * ws
         k2 = k1 * norm_j / det_p
         # d/dP of |J|^2 det_r^2 / det_p^2 = 2 P G s - 2 |J|^2 s / det_p * cof(P),
         # cof(P) = [[dd, -c], [-b, a]].
-        col0 = np.column_stack([k1 * pg11 - k2 * dd, k1 * pg21 + k2 * b])
-        col1 = np.column_stack([k1 * pg12 + k2 * c, k1 * pg22 - k2 * a])
-        grad = grad + self.face_scatter @ np.concatenate([col0, col1])
-        return value, grad
+        gx = np.concatenate([k1 * pg11 - k2 * dd, k1 * pg12 + k2 * c])
+        gy = np.concatenate([k1 * pg21 + k2 * b, k1 * pg22 - k2 * a])
+        return value, self.face_scatter @ np.column_stack([gx, gy])
+
+    def parts(self, u, mu):
+        """``(S, grad S, B, grad B)``; B is 0 (gradient None) when ``mu == 0``, inf when folded."""
+        value, grad = self.stress(u)
+        if mu == 0:
+            return value, grad, 0.0, None
+        b_value, b_grad = self.barrier(u)
+        return value, grad, b_value, b_grad
+
+    def __call__(self, u, mu):
+        """``(E, gradient (n, 2))``; ``(inf, None)`` if ``mu > 0`` and a triangle is folded."""
+        value, grad, b_value, b_grad = self.parts(u, mu)
+        if mu == 0:
+            return value, grad
+        if b_grad is None:
+            return np.inf, None
+        return value + mu * b_value, grad + mu * b_grad
 
 
 def _quasi_newton(energy, faces, loops, uv, free, lu, *, refactor, barrier, max_iterations, tolerance, floor,
@@ -325,16 +355,26 @@ def _quasi_newton(energy, faces, loops, uv, free, lu, *, refactor, barrier, max_
     curvature while the barrier is on, refreshed every ``_REFRESH``
     iterations), scaled by the latest ``s.y / y.H0 y``.  ``H0`` is applied to
     each accepted gradient once and kept, so that the two-loop recursion needs
-    no further solve.  Returns ``(uv, iterations, converged)``.
+    no further solve.  The memory is dropped only when ``H0`` changes.
+    Returns ``(uv, iterations, converged)``.
     """
     size = _size(uv)
     mu = float(barrier)
+    everywhere = bool(free.all())
+
+    def restrict(g):
+        return g if everywhere else g[free]
 
     def evaluate(u):
-        value, grad = energy(u, mu)
-        return value, (None if grad is None else grad[free])
+        """``(E, grad E on the free vertices, S, grad S, B, grad B)``; E is inf when folded."""
+        s_value, s_grad, b_value, b_grad = energy.parts(u, mu)
+        if mu == 0:
+            return s_value, restrict(s_grad), s_value, s_grad, b_value, b_grad
+        if b_grad is None:
+            return np.inf, None, s_value, s_grad, b_value, b_grad
+        return s_value + mu * b_value, restrict(s_grad + mu * b_grad), s_value, s_grad, b_value, b_grad
 
-    value, grad = evaluate(uv)
+    value, grad, *terms = evaluate(uv)
     base = lu
     since_refresh = _REFRESH  # refresh at once if the barrier is on
     history = []  # (s, y, H0 y)
@@ -345,36 +385,37 @@ def _quasi_newton(energy, faces, loops, uv, free, lu, *, refactor, barrier, max_
     while iterations < max_iterations:
         iterations += 1
         if mu > 0 and since_refresh >= _REFRESH:
-            lu, since_refresh = refactor(uv, mu), 0
-            hgrad, history = None, []
+            fresh, since_refresh = refactor(uv, mu), 0
+            if fresh is not lu:
+                lu, hgrad, history = fresh, None, []
         since_refresh += 1
         if hgrad is None:
             hgrad = 0.5 * lu.solve(grad)
         direction = np.zeros_like(uv)
         direction[free] = -_two_loop(grad, hgrad, history)
-        slope = float(np.sum(grad * direction[free]))
+        slope = _dot(grad, restrict(direction))
         if not slope < 0:  # stale memory: fall back to the preconditioned gradient
             history = []
             direction[free] = -hgrad
-            slope = float(np.sum(grad * direction[free]))
+            slope = _dot(grad, restrict(direction))
         step = min(1.0, 0.9 * float(flip_free_steps(faces, uv, direction, horizon=1.0 / 0.9).min()))
         # Steps below round-off of the layout's size make no progress.
         smallest = 1e-13 * size / max(float(np.abs(direction).max()), 1e-300)
         moved = False
         while step > smallest:
             cand = uv + step * direction
-            new_value, new_grad = evaluate(cand)
+            new_value, new_grad, *new_terms = evaluate(cand)
             if new_value <= value + 1e-4 * step * slope and _boundary_crossings(cand, loops) is None:
                 moved = True
                 break
             step *= 0.5
         if moved:
             new_hgrad = 0.5 * lu.solve(new_grad)
-            s, y = (cand - uv)[free], new_grad - grad
-            if float(np.sum(s * y)) > 0:
+            s, y = restrict(cand - uv), new_grad - grad
+            if _dot(s, y) > 0:
                 history.append((s, y, new_hgrad - hgrad))
                 del history[:-_MEMORY]
-            uv, value, grad, hgrad = cand, new_value, new_grad, new_hgrad
+            uv, value, grad, hgrad, terms = cand, new_value, new_grad, new_hgrad, new_terms
         if progress is not None:
             progress(offset + iterations, total)
         if not moved and history:
@@ -390,19 +431,26 @@ def _quasi_newton(energy, faces, loops, uv, free, lu, *, refactor, barrier, max_
         if last and (stalled or value <= floor):
             converged = True
             break
-        if stalled:  # next stage: a tenth of the barrier, or none
-            mu = mu * 0.1 if mu > _WEAKEST * 1.5 else 0.0
-            value, grad = evaluate(uv)
-            lu, since_refresh = (refactor(uv, mu) if mu > 0 else base), 0
-            hgrad, history, recent = None, [], [value]
+        if stalled:  # next stage: a tenth of the barrier, or none; the terms are at hand
+            mu = mu * _DROP if mu > _WEAKEST * 1.5 else 0.0
+            s_value, s_grad, b_value, b_grad = terms
+            value = s_value + mu * b_value
+            grad = restrict(s_grad + mu * b_grad) if mu > 0 else restrict(s_grad)
+            fresh, since_refresh = (refactor(uv, mu) if mu > 0 else base), 0
+            lu, history, hgrad, recent = fresh, [], None, [value]
     return uv, iterations, converged
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    """Sum of the elementwise product of two arrays of one shape, without a temporary."""
+    return float(np.vdot(a, b))
 
 
 def _two_loop(grad, hgrad, history):
     """L-BFGS two-loop recursion; ``H0`` products come precomputed (``hgrad``, ``H0 y``)."""
     alphas = []
     for s, y, _ in reversed(history):
-        alphas.append(float(np.sum(s * grad)) / float(np.sum(y * s)))
+        alphas.append(_dot(s, grad) / _dot(y, s))
         grad = grad - alphas[-1] * y
     # H0 q = H0 g - sum a_i H0 y_i (H0 is linear).
     r = hgrad.copy()
@@ -410,9 +458,9 @@ def _two_loop(grad, hgrad, history):
         r -= a * hy
     if history:
         s, y, hy = history[-1]
-        r *= float(np.sum(s * y)) / float(np.sum(y * hy))
+        r *= _dot(s, y) / _dot(y, hy)
     for (s, y, _), a in zip(history, reversed(alphas)):
-        b = float(np.sum(y * r)) / float(np.sum(y * s))
+        b = _dot(y, r) / _dot(y, s)
         r += (a - b) * s
     return r
 
@@ -448,6 +496,16 @@ def _travel_to_pins(faces, loops, e, length, weight, laplacian, free, uv, pin_in
             break
         uv = moved
     return np.array(uv), iterations
+
+
+def _laplacian(n: int, edges: np.ndarray, weight: np.ndarray, *, anchor: float = 0.0) -> sp.csc_matrix:
+    """The graph Laplacian ``D - W`` with edge weights ``weight`` (plus ``anchor`` at vertex 0), ``(n, n)`` CSC."""
+    e0, e1 = edges[:, 0], edges[:, 1]
+    diagonal = np.bincount(e0, weight, n) + np.bincount(e1, weight, n)
+    diagonal[0] += anchor
+    node = np.arange(n)
+    return sp.csc_matrix((np.r_[-weight, -weight, diagonal], (np.r_[e0, e1, node], np.r_[e1, e0, node])),
+                         shape=(n, n))
 
 
 def _size(uv: np.ndarray) -> float:
