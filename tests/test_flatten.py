@@ -94,7 +94,10 @@ def test_true_scale_follows_the_input_unit(method):
     v, f = surfaces.paraboloid_dish(n_faces=1000)
     mm = patterns.flatten_mesh(v, f, method=method).uv
     inch = patterns.flatten_mesh(v / 25.4, f, method=method).uv
-    np.testing.assert_allclose(inch * 25.4, mm, atol=1e-8)
+    # A nanometre on a 600 mm part: the relaxation's single-precision
+    # preconditioner may round a few entries differently in the two units
+    # (measured 1.9e-8 mm); any rescaling would show as millimetres.
+    np.testing.assert_allclose(inch * 25.4, mm, atol=1e-6)
 
 
 # --------------------------------------------------------------------------- the paper's step
