@@ -25,6 +25,10 @@ Methods
 * ``relaxed-tight``: ``relaxed`` with ``max_iterations=5000, tolerance=1e-9`` (timed
   once, up to ``--max-faces-tight`` faces): the least edge strain the method reaches
   when time does not matter.  Not judged; it shows where a criterion is out of reach.
+* ``arap+relaxed``: the same tight relaxation started from libigl ARAP's layout
+  (where that is one-to-one, up to ``--max-faces-tight`` faces; the time is the
+  relaxation's alone).  Not judged; it shows whether the least-squares optimum
+  depends on the start.
 * ``lscm``: ``igl.lscm`` with the two farthest-apart boundary vertices pinned at
   their 3D distance apart.  LSCM has no scale of its own, so before measuring its
   uv is multiplied by the single factor that makes the total flat area equal to

@@ -19,6 +19,7 @@ import numpy as np
 import shapely
 
 from .measure import folded_faces
+from .mesh import _readonly
 
 __all__ = ["REPORT_SCHEMA", "Code", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
            "boundary_crossings", "check", "crossing_segments", "overlap_verdict"]
@@ -354,7 +355,7 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
                 worst = above[np.argmax(mag[above])]
                 centre = uv[faces[worst]].mean(axis=0)
                 findings.append(Finding(
-                    Code.STRAIN_ABOVE_LIMIT, Severity.LIMIT, (flat.name,), centre[None, :], _ro(above), None,
+                    Code.STRAIN_ABOVE_LIMIT, Severity.LIMIT, (flat.name,), centre[None, :], _readonly(above), None,
                     f"panel {flat.name}: strain above {max_strain:.2%} on {share:.1%} of its area "
                     f"({len(above)} triangles), up to {mag[worst]:.2%} at ({centre[0]:.1f}, {centre[1]:.1f}) mm"))
         findings += _panel_overlaps(flat)
@@ -362,7 +363,7 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
         if flat.darts:
             tips = np.array([uv[d[-1]] for d in flat.darts])
             length = sum(float(np.linalg.norm(np.diff(vertices[d], axis=0), axis=1).sum()) for d in flat.darts)
-            findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), _ro(tips), np.zeros(0, dtype=np.int64),
+            findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), _readonly(tips), np.zeros(0, dtype=np.int64),
                                     None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
                                           f"the limit ({length:.1f} mm of cuts; points: their tips)"))
         if not res.converged:
@@ -396,12 +397,6 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
     findings.sort(key=lambda f: order[f.severity])
     return Report(pattern.name, tuple(panel_reports), tuple(seam_reports), tuple(findings), max_strain,
                   max_seam_mismatch)
-
-
-def _ro(a) -> np.ndarray:
-    a = np.asarray(a)
-    a.setflags(write=False)
-    return a
 
 
 def crossing_segments(uv: np.ndarray, loops):
@@ -463,7 +458,7 @@ def _panel_overlaps(flat) -> list:
     if len(folded):
         centres = uv[faces[folded]].mean(axis=1)
         c = centres[0]
-        out.append(Finding(Code.FOLDED_TRIANGLES, Severity.ERROR, (name,), _ro(centres), _ro(folded), None,
+        out.append(Finding(Code.FOLDED_TRIANGLES, Severity.ERROR, (name,), _readonly(centres), _readonly(folded), None,
                            f"panel {name}: {len(folded)} folded triangles (first: face {int(folded[0])} "
                            f"at ({c[0]:.1f}, {c[1]:.1f}) mm)"))
     for a, b, pts in boundary_crossings(uv, loops):
@@ -471,7 +466,7 @@ def _panel_overlaps(flat) -> list:
         what = ("its outline crosses itself" if a == b == 0 else
                 f"hole {b} crosses the outline" if a == 0 else
                 f"hole {a} crosses itself" if a == b else f"holes {a} and {b} cross")
-        out.append(Finding(code, Severity.ERROR, (name,), _ro(pts), none, None,
+        out.append(Finding(code, Severity.ERROR, (name,), _readonly(pts), none, None,
                            f"panel {name}: {what} at {len(pts)} points (first: ({pts[0, 0]:.1f}, {pts[0, 1]:.1f}) mm)"))
     rings = [shapely.linearrings(uv[loop]) for loop in loops]
     if not shapely.is_ccw(rings[0]):
@@ -509,6 +504,6 @@ def _overlaps_between(pattern) -> list:
             continue  # touching along an edge or at a point
         p = shapely.get_coordinates(shapely.point_on_surface(common))[0]
         na, nb = pattern.panels[a].name, pattern.panels[b].name
-        out.append(Finding(Code.PANELS_OVERLAP, Severity.ERROR, (na, nb), _ro(p[None, :]), none, None,
+        out.append(Finding(Code.PANELS_OVERLAP, Severity.ERROR, (na, nb), _readonly(p[None, :]), none, None,
                            f"panels {na} and {nb} overlap by {area:.1f} mm^2 around ({p[0]:.1f}, {p[1]:.1f}) mm"))
     return out

@@ -36,7 +36,9 @@ __all__ = [
 ]
 
 
-def _readonly(array: np.ndarray) -> np.ndarray:
+def _readonly(array) -> np.ndarray:
+    """``array`` as an ndarray (the same object if it is one) that cannot be written."""
+    array = np.asarray(array)
     array.setflags(write=False)
     return array
 

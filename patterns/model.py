@@ -12,13 +12,9 @@ from enum import Enum
 
 import numpy as np
 
+from .mesh import _readonly
+
 __all__ = ["Model", "Panel", "Seam", "Surface", "SurfaceKind"]
-
-
-def _readonly(a) -> np.ndarray:
-    a = np.asarray(a)
-    a.setflags(write=False)
-    return a
 
 
 class SurfaceKind(str, Enum):

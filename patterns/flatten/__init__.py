@@ -15,7 +15,7 @@ import numpy as np
 from ..check import Overlap, overlap_verdict
 from ..errors import FlattenError, InputError
 from ..measure import Distortion, distortion, local_coordinates, signed_areas
-from ..mesh import validate_mesh
+from ..mesh import _readonly, validate_mesh
 from . import grow
 from .embed import lscm, tutte_embedding
 from .relax import align_to_pins, best_scale, check_pins, relax
@@ -24,11 +24,6 @@ __all__ = ["METHODS", "Flattening", "flatten", "flatten_mesh"]
 
 METHODS = ("relaxed", "isometric", "conformal")
 """The flattening methods :func:`flatten_mesh` accepts."""
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, eq=False)
