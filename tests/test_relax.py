@@ -231,3 +231,26 @@ def test_refactorisation_reusing_the_ordering_solves_the_same_system():
     row_sums = np.asarray(matrix.sum(axis=1)).ravel()
     assert row_sums[0] == pytest.approx(w.mean(), rel=1e-12)
     assert np.abs(row_sums[1:]).max() < 1e-9 * w2.max()
+
+
+def test_single_precision_factor_is_a_close_unit_free_preconditioner():
+    """The relaxation's preconditioner is factorised in float32; its solves must
+    stay close to the float64 ones and must not depend on the unit."""
+    from patterns.flatten.embed import factorize
+    from patterns.flatten.relax import _laplacian
+
+    v, f = surfaces.ellipsoid_cup(n_faces=10_000)
+    v, f, conn = validate_mesh(v, f)
+    e = conn.edges
+    rng = np.random.default_rng(11)
+    b = rng.normal(size=(len(v), 2))
+    solutions = []
+    for unit in (1.0, 25.4):  # mm, then the same part in inches
+        w = 1.0 / np.linalg.norm((v[e[:, 1]] - v[e[:, 0]]) / unit, axis=1) ** 2
+        matrix = _laplacian(len(v), e, w, anchor=float(w.mean()))
+        exact = factorize(matrix).solve(b)
+        single = factorize(matrix, single=True).solve(b)
+        assert single.dtype == np.float64
+        assert np.linalg.norm(single - exact) < 1e-3 * np.linalg.norm(exact)
+        solutions.append(single * unit**2)  # L scales as unit**2, so L^-1 b as unit**-2
+    assert np.allclose(solutions[0], solutions[1], rtol=0, atol=1e-6 * np.abs(solutions[0]).max())
