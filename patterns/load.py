@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import CadError, InputError
-from .mesh import as_mesh_arrays, validate_mesh
+from .mesh import as_mesh_arrays, unique_ints, validate_mesh
 
 __all__ = ["CAD_SUFFIXES", "MESH_SUFFIXES", "MeshFile", "drop_unused", "load", "mesh_model", "read_cad", "read_mesh", "weld"]
 
@@ -79,9 +79,9 @@ def weld(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarra
     n_unused : int
         Vertices that no face used.
     """
-    used = np.unique(faces.ravel())
+    used = unique_ints(faces)
     n_unused = len(vertices) - len(used)
-    _, first, inverse = np.unique(vertices[used], axis=0, return_index=True, return_inverse=True)
+    first, inverse = _unique_rows(vertices[used])
     # Keep the order of first appearance (stable, deterministic output).
     rank = np.empty(len(first), dtype=np.int64)
     rank[np.argsort(first, kind="stable")] = np.arange(len(first))
@@ -89,6 +89,19 @@ def weld(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarra
     remap[used] = rank[inverse.ravel()]
     new_vertices = vertices[used][np.sort(first)]
     return new_vertices, remap[faces], len(used) - len(first), n_unused
+
+
+def _unique_rows(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Groups of equal rows: ``(first, inverse)`` as ``np.unique(points, axis=0, return_index=True,
+    return_inverse=True)`` gives them, several times faster (one lexsort instead of a sort of
+    row records)."""
+    order = np.lexsort(points.T[::-1])
+    ordered = points[order]
+    starts = np.ones(len(points), dtype=bool)
+    starts[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+    inverse = np.empty(len(points), dtype=np.int64)
+    inverse[order] = np.cumsum(starts) - 1
+    return order[starts], inverse  # lexsort is stable: each group's first row is its lowest index
 
 
 def drop_unused(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:

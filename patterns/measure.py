@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .mesh import edge_lengths, side_vectors
+from .mesh import edge_lengths, side_vectors, unique_ints
 
 __all__ = [
     "Distortion",
@@ -127,9 +127,13 @@ def folded_faces(faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
 
 
 def _unique_edges(faces: np.ndarray) -> np.ndarray:
-    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    e.sort(axis=1)
-    return np.unique(e, axis=0)
+    """The sorted unique undirected edges ``(e, 2) int64``, ``[:, 0] < [:, 1]``."""
+    a = faces.astype(np.int64).T.ravel()  # corners 0, then 1, then 2
+    b = faces[:, [1, 2, 0]].astype(np.int64).T.ravel()
+    n = int(faces.max()) + 1 if len(faces) else 1
+    # One int64 key per edge, ordered as the (low, high) rows would be.
+    keys = unique_ints(np.minimum(a, b) * n + np.maximum(a, b))
+    return np.column_stack([keys // n, keys % n])
 
 
 def edge_strain(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, edges: np.ndarray | None = None) -> np.ndarray:

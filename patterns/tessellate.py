@@ -14,7 +14,7 @@ from scipy.sparse import csgraph
 from .errors import CadError, InputError
 from .load import drop_unused
 from .cut import cut_to_disk
-from .mesh import face_areas, validate_mesh
+from .mesh import face_areas, unique_ints, validate_mesh
 
 __all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
 
@@ -630,8 +630,8 @@ class _ShapeMesher:
         tri = tri[keep]
         # Every boundary segment must be an edge of a kept triangle.
         n_pts = len(points)
-        have = np.unique(np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
-                         @ np.array([n_pts, 1]))
+        have = unique_ints(np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+                           @ np.array([n_pts, 1]))
         need = np.sort(np.stack([segs_a, segs_b], axis=1), axis=1) @ np.array([n_pts, 1])
         missing = ~np.isin(need, have)
         if missing.any():
@@ -692,7 +692,7 @@ class _ShapeMesher:
         for p, (label, members) in enumerate(groups):
             tri = np.concatenate([offsets[k] + meshes[k].triangles for k in members])
             fv = np.concatenate([np.arange(offsets[k], offsets[k + 1]) for k in members])
-            roots, first = np.unique(root[fv], return_index=True)
+            roots, first = unique_ints(root[fv], return_index=True)
             order = np.argsort(first)
             index = np.full(root.max() + 1, -1, dtype=np.int64)
             index[roots[order]] = np.arange(len(roots))
@@ -904,7 +904,7 @@ def _flip_to_delaunay(xyz: np.ndarray, uv: np.ndarray, tri: np.ndarray, fixed: n
     """
     tri = tri.copy()
     n = len(xyz)
-    fixed_key = np.unique(np.sort(fixed, axis=1) @ np.array([n, 1]))
+    fixed_key = unique_ints(np.sort(fixed, axis=1) @ np.array([n, 1]))
 
     def orient(a, b, c):
         return (uv[b, 0] - uv[a, 0]) * (uv[c, 1] - uv[a, 1]) - (uv[b, 1] - uv[a, 1]) * (uv[c, 0] - uv[a, 0])
@@ -941,12 +941,12 @@ def _flip_to_delaunay(xyz: np.ndarray, uv: np.ndarray, tri: np.ndarray, fixed: n
         np.maximum.at(claim, t2[cand], viol[cand])
         win = cand[(claim[t1[cand]] == viol[cand]) & (claim[t2[cand]] == viol[cand])]
         # Ties could let one triangle win two edges: keep one edge per triangle.
-        _, first1 = np.unique(t1[win], return_index=True)
+        _, first1 = unique_ints(t1[win], return_index=True)
         win = win[first1]
-        _, first2 = np.unique(t2[win], return_index=True)
+        _, first2 = unique_ints(t2[win], return_index=True)
         win = win[first2]
         used = np.concatenate([t1[win], t2[win]])
-        if len(np.unique(used)) != len(used):
+        if len(unique_ints(used)) != len(used):
             win = win[:1]
         tri[t1[win]] = np.stack([a[win], d[win], c[win]], axis=1)
         tri[t2[win]] = np.stack([d[win], b[win], c[win]], axis=1)

@@ -142,3 +142,27 @@ def test_column_helpers_match_the_row_formulas():
                            rtol=1e-12, atol=0)
     assert np.all((np.conj(z[:, 1]) * z[:, 2]).imag > 0)
     assert np.allclose(0.5 * (np.conj(z[:, 1]) * z[:, 2]).imag, face_areas(v, f), rtol=1e-12, atol=0)
+
+
+def test_sort_based_unique_matches_numpy():
+    from patterns.load import _unique_rows
+    from patterns.measure import _unique_edges
+    from patterns.mesh import unique_ints
+
+    rng = np.random.default_rng(2)
+    for size in (0, 1, 7, 5000):
+        a = rng.integers(-3, 400, size)
+        ours = unique_ints(a, return_index=True, return_inverse=True)
+        theirs = np.unique(a, return_index=True, return_inverse=True)
+        for x, y in zip(ours, theirs):
+            assert np.array_equal(x, np.ravel(y))
+    # Rows (vertex welding): a triangle soup with every corner repeated.
+    v, f = surfaces.ellipsoid_cup(n_faces=2000)
+    soup = v[f.ravel()]
+    first, inverse = _unique_rows(soup)
+    _, first2, inverse2 = np.unique(soup, axis=0, return_index=True, return_inverse=True)
+    assert np.array_equal(first, first2) and np.array_equal(inverse, inverse2.ravel())
+    assert len(first) == len(v)
+    # Edges: the sorted unique (low, high) pairs.
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    assert np.array_equal(_unique_edges(f), np.unique(e, axis=0))

@@ -57,7 +57,7 @@ import numpy as np
 from scipy.sparse import coo_matrix, csgraph
 
 from ..errors import FlattenError
-from ..mesh import Connectivity, edge_lengths
+from ..mesh import Connectivity, edge_lengths, unique_ints
 
 __all__ = [
     "grow_fronts",
@@ -184,7 +184,7 @@ def seed_face(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity) -> in
     length = edge_lengths(vertices, e)
     n = conn.n_vertices
     graph = coo_matrix((length, (e[:, 0], e[:, 1])), shape=(n, n)).tocsr()
-    sources = np.unique(np.concatenate(conn.loops))
+    sources = unique_ints(np.concatenate(conn.loops))
     dist = csgraph.dijkstra(graph, directed=False, indices=sources, min_only=True)
     return int(np.argmax(dist[faces].sum(axis=1)))
 
@@ -250,7 +250,7 @@ def grow_fronts(z: np.ndarray, faces: np.ndarray, conn: Connectivity, weights: n
         idx = np.repeat(start - np.cumsum(lens) + lens, lens) + np.arange(lens.sum())
         inc = vfaces[idx]
         np.add.at(count, inc, 1)
-        ready = np.unique(inc[count[inc] == 2])
+        ready = unique_ints(inc[count[inc] == 2])
         if len(ready) == 0:
             break
         fr = faces[ready]
@@ -261,7 +261,7 @@ def grow_fronts(z: np.ndarray, faces: np.ndarray, conn: Connectivity, weights: n
         rot = None if rotations is None else rotations[ready]
         cand = step(zr[rows, ja], zr[rows, jb], zr[rows, j], w[fr[rows, ja]], w[fr[rows, jb]], rot)
         free = fr[rows, j]
-        new, inv = np.unique(free, return_inverse=True)
+        new, inv = unique_ints(free, return_inverse=True)
         wt = weights[ready]
         total = np.bincount(inv, wt)
         w[new] = (np.bincount(inv, wt * cand.real) + 1j * np.bincount(inv, wt * cand.imag)) / total
