@@ -13,6 +13,7 @@ The public API, all importable from the top level::
 """
 
 from .check import Finding, Overlap, Report, check, overlap_verdict
+from .cut import Cut, cut_to_disk
 from .errors import (
     CadError,
     ExportError,
@@ -22,7 +23,6 @@ from .errors import (
     MeshTopologyError,
     PatternsError,
 )
-from .cut import Cut, cut_to_disk
 from .export import heat_map, preview_dxf
 from .flatten import METHODS, Flattening, flatten, flatten_mesh
 from .layout import Layout, layout
@@ -42,10 +42,10 @@ __all__ = [
     "Cut",
     "Distortion",
     "ExportError",
-    "FlattenError",
     "Finding",
     "FlatPanel",
     "FlatSeam",
+    "FlattenError",
     "Flattening",
     "InputError",
     "Layout",

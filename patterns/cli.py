@@ -406,7 +406,8 @@ def _cmd_batch(args) -> int:
     rows = []
     if args.scheduler:
         try:
-            from distributed import Client, as_completed as dask_completed
+            from distributed import Client
+            from distributed import as_completed as dask_completed
         except ImportError:
             raise InputError("--scheduler needs Dask: pip install 'patterns[dask]'") from None
         try:

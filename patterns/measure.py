@@ -28,13 +28,13 @@ __all__ = [
     "boundary_lengths",
     "distortion",
     "edge_strain",
-    "strain_summary",
-    "triangle_strains",
-    "weighted_percentile",
     "folded_faces",
     "local_coordinates",
     "principal_stretches",
     "signed_areas",
+    "strain_summary",
+    "triangle_strains",
+    "weighted_percentile",
 ]
 
 

@@ -31,8 +31,8 @@ __all__ = [
     "edge_tables",
     "face_areas",
     "side_vectors",
-    "unique_ints",
     "trace_loops",
+    "unique_ints",
     "validate_mesh",
 ]
 

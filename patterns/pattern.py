@@ -330,7 +330,7 @@ class Pattern:
 
         heat_map(self, path, **options)
 
-    def placed(self, placements) -> "Pattern":
+    def placed(self, placements) -> Pattern:
         """A copy with the panels moved rigidly: one ``(angle, dx, dy)`` per panel.
 
         Rotation (radians) about the origin of the flattened panel, then a

@@ -7,13 +7,12 @@ seconds).
 from __future__ import annotations
 
 import numpy as np
-
 import scipy.sparse as sp
 from scipy.sparse import csgraph
 
+from .cut import cut_to_disk
 from .errors import CadError, InputError
 from .load import drop_unused
-from .cut import cut_to_disk
 from .mesh import face_areas, unique_ints, validate_mesh
 
 __all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
@@ -157,10 +156,10 @@ def _sewn(shape, tolerance: float):
     edge of the same length and ends does too, i.e. two faces meet there
     without sharing the edge; the face count must survive the sewing.
     """
+    from OCP.BRep import BRep_Tool
     from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
     from OCP.TopExp import TopExp, TopExp_Explorer
-    from OCP.BRep import BRep_Tool
     from OCP.TopoDS import TopoDS
 
     faces = _Registry()

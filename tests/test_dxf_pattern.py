@@ -280,7 +280,7 @@ def test_librecad_renders_the_file(plate, tmp_path, version):
                           env=_qt_env(tmp_path), timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     data = pdf.read_bytes()
-    content = b"".join(_inflate(s) for s in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, re.S))
+    content = b"".join(_inflate(s) for s in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, re.DOTALL))
     # Drawn as vector paths: at least one line-to for every cut vertex.
     n_vertices = sum(len(loop) for flat in plate.panels for loop in flat.loops)
     assert len(re.findall(rb"\sl\s", content)) >= n_vertices

@@ -1,10 +1,9 @@
 """DXF and OBJ output, read back by ezdxf and trimesh; atomic writes."""
 
 import os
-
-import ezdxf
 from pathlib import Path
 
+import ezdxf
 import numpy as np
 import pytest
 import shapely

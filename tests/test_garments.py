@@ -1,6 +1,5 @@
 """Garments and soft goods: grain, matching notches, nesting."""
 
-import re
 
 import build123d as bd
 import ezdxf
@@ -9,11 +8,11 @@ import pytest
 import shapely
 
 import patterns
+from patterns import surfaces  # noqa: F401  (patterns.surfaces below)
 from patterns.errors import InputError
 from patterns.export.dxf import notch_positions
 from patterns.flatten import flat_direction
 from patterns.samples import cup, duct_transition, hopper, hull_panel
-from patterns import surfaces  # noqa: F401  (patterns.surfaces below)
 
 from .conftest import SAMPLES
 

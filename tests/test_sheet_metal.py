@@ -1,7 +1,7 @@
 """Sheet metal: exact unrolling, thickness and K-factor, bend lines, arcs -- checked
 against blanks computed from the drawing, not from the code under test."""
 
-from math import atan2, hypot, pi
+from math import hypot, pi
 
 import build123d as bd
 import ezdxf

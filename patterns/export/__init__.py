@@ -1,9 +1,8 @@
 """Writing results: DXF cutting patterns, flat meshes, heat maps, always atomically."""
 
 from ._atomic import atomic_output
-from .dxf import write_outline_dxf
+from .dxf import write_outline_dxf, write_pattern_dxf
 from .heatmap import heat_map
-from .dxf import write_pattern_dxf
 from .mesh import write_flat_obj
 from .preview import preview_dxf
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["fit_arcs", "arc_points"]
+__all__ = ["arc_points", "fit_arcs"]
 
 
 def _circle(a, b, c):

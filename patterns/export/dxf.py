@@ -498,10 +498,10 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, stra
 def _save(doc, path) -> None:
     """Save with fixed metadata (dates 2000-01-01, constant GUIDs): the same pattern and
     options always give a byte-identical file."""
-    import ezdxf
-
     import re
     from pathlib import Path
+
+    import ezdxf
 
     old = ezdxf.options.write_fixed_meta_data_for_testing
     ezdxf.options.write_fixed_meta_data_for_testing = True

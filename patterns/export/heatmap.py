@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import InputError
 from ._atomic import atomic_output
 
-__all__ = ["HEAT_MAP_FORMATS", "heat_map", "display_offsets"]
+__all__ = ["HEAT_MAP_FORMATS", "display_offsets", "heat_map"]
 
 HEAT_MAP_FORMATS = (".png", ".svg")
 """File suffixes :func:`heat_map` writes."""

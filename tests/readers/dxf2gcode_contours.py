@@ -16,15 +16,14 @@ import sys
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
-from PyQt5.QtWidgets import QApplication  # noqa: E402
-
-import dxf2gcode.globals.globals as g  # noqa: E402
-from dxf2gcode.globals.config import MyConfig  # noqa: E402
+import dxf2gcode.globals.globals as g
+from dxf2gcode.globals.config import MyConfig
+from PyQt5.QtWidgets import QApplication
 
 app = QApplication(sys.argv[:1])
 g.folder = os.path.join(os.path.expanduser("~"), ".config/dxf2gcode")  # as /usr/bin/dxf2gcode sets it
 g.config = MyConfig()
-from dxf2gcode.dxfimport.importer import ReadDXF  # noqa: E402
+from dxf2gcode.dxfimport.importer import ReadDXF
 
 values = ReadDXF(sys.argv[1])
 layers = {i: layer.name for i, layer in enumerate(values.layers)}
