@@ -95,6 +95,9 @@ def _parser() -> argparse.ArgumentParser:
     def flattening(p):
         p.add_argument("--method", choices=METHODS, default="relaxed", help="flattening method (default relaxed)")
         p.add_argument("--max-iterations", type=int, default=500, help="relaxation iterations at most (default 500)")
+        p.add_argument("--min-stretch", type=float, default=None, metavar="R",
+                       help="relaxed: keep every triangle at least this fraction of its size in every direction, "
+                            "0..1 (0.3 stops a dome's pole being pressed flat)")
         p.add_argument("--thickness", type=float, default=0.0, help="sheet thickness, mm: develop the neutral surface")
         p.add_argument("--k-factor", type=float, default=0.5, help="neutral surface from the inside, 0..1 (default 0.5)")
         p.add_argument("--reference", choices=("inside", "outside", "mid"), default="mid",
@@ -184,7 +187,8 @@ def _flatten(model, args):
     progress = Progress(f"flattening {len(model.panels)} panels")
     try:
         return flatten(model, method=args.method, max_iterations=args.max_iterations, thickness=args.thickness,
-                       k_factor=args.k_factor, reference=args.reference, grain=args.grain, progress=progress)
+                       k_factor=args.k_factor, reference=args.reference, grain=args.grain,
+                       min_stretch=args.min_stretch, progress=progress)
     finally:
         progress.close()
 
@@ -361,7 +365,7 @@ def _batch_one(path: str, out: str, options: dict) -> dict:
         model = _load(args)
         pattern = flatten(model, method=options["method"], max_iterations=options["max_iterations"],
                           thickness=options["thickness"], k_factor=options["k_factor"], reference=options["reference"],
-                          grain=options["grain"])
+                          grain=options["grain"], min_stretch=options["min_stretch"])
         if options["roll_width"] is not None:
             pattern = pattern.layout(width=options["roll_width"], margin=options["seam_allowance"]).pattern
         report = check(pattern, max_strain=options["max_strain"], max_seam_mismatch=options["max_seam_mismatch"])
@@ -401,7 +405,7 @@ def _cmd_batch(args) -> int:
     options = {k: getattr(args, k) for k in ("max_edge", "tolerance", "method", "max_iterations", "max_strain",
                                               "max_seam_mismatch", "profile", "seam_allowance", "dxf_version",
                                               "thickness", "k_factor", "reference", "arcs", "bend_spacing",
-                                              "grain", "notch_spacing", "roll_width")}
+                                              "grain", "notch_spacing", "roll_width", "min_stretch")}
     progress = Progress(f"batch of {len(files)} files")
     rows = []
     if args.scheduler:
@@ -451,10 +455,49 @@ COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "de
             "batch": _cmd_batch}
 
 
+class _ClosedPipeSafe:
+    """Standard output that outlives its reader.
+
+    ``patterns flatten part.step | head -1`` closes the pipe after one line; the
+    files must still be written and no traceback shown, so output to a closed
+    pipe is dropped (and the descriptor pointed at ``/dev/null``, so that the
+    interpreter's last flush is quiet too).
+    """
+
+    def __init__(self, stream):
+        self._stream, self._gone = stream, False
+
+    def write(self, text: str) -> int:
+        if not self._gone:
+            try:
+                return self._stream.write(text)
+            except BrokenPipeError:
+                self._close()
+        return len(text)
+
+    def flush(self) -> None:
+        if not self._gone:
+            try:
+                self._stream.flush()
+            except BrokenPipeError:
+                self._close()
+
+    def _close(self) -> None:
+        self._gone = True
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
+        except (OSError, ValueError, AttributeError):  # not a real file (a test's capture)
+            pass
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv=None) -> int:
     """Run the command line; returns the exit code."""
     argv = sys.argv[1:] if argv is None else argv
     debug = "--debug" in argv
+    stdout, sys.stdout = sys.stdout, _ClosedPipeSafe(sys.stdout)
     try:
         args = _parser().parse_args(argv)
         return COMMANDS[args.command](args)
@@ -465,6 +508,9 @@ def main(argv=None) -> int:
         return EXIT_INPUT
     except KeyboardInterrupt:  # pragma: no cover
         return 130
+    finally:
+        sys.stdout.flush()
+        sys.stdout = stdout
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -286,3 +286,40 @@ def test_garment_options(tmp_path):
     assert max(c.bounds[2] for c in cuts) <= 600 + 1e-6 and min(c.bounds[0] for c in cuts) >= -1e-6
     bad = run("flatten", SAMPLES / "cup.step", "-o", tmp_path / "x.dxf", "--grain", "1,2")
     assert bad.returncode == 2 and "X,Y,Z" in bad.stderr
+
+
+def test_a_closed_pipe_does_not_stop_the_files_or_show_a_traceback(tmp_path):
+    """``patterns flatten ... | head -1``: the reader goes away after a line."""
+    if not EXE.exists():
+        pytest.skip(f"the entry point {EXE} is not installed (pip install the package)")
+    out = tmp_path / "dish.dxf"
+    proc = subprocess.Popen([str(EXE), "flatten", str(SAMPLES / "dish.obj"), "-o", str(out), "--report",
+                             str(tmp_path / "dish.json")], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # nobody reads: every line printed hits a closed pipe
+    stderr = proc.stderr.read().decode()
+    assert proc.wait(timeout=300) == 0, stderr
+    assert "Traceback" not in stderr and "BrokenPipe" not in stderr
+    doc, auditor = recover.readfile(out)
+    assert not auditor.has_errors and len(doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')) == 1
+    assert json.loads((tmp_path / "dish.json").read_text())["panels"][0]["one_to_one"]
+
+
+def test_min_stretch_keeps_a_dome_from_being_pressed_flat(tmp_path):
+    import trimesh
+
+    from patterns import surfaces
+
+    v, f = surfaces.spherical_cap(radius=100.0, half_angle=90.0, n_faces=4000)
+    path = tmp_path / "dome.stl"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    strain = {}
+    for label, extra in (("plain", ()), ("guarded", ("--min-stretch", "0.3"))):
+        report = tmp_path / f"{label}.json"
+        proc = run("flatten", path, "-o", tmp_path / f"{label}.dxf", "--report", report, *extra)
+        assert proc.returncode == 0, proc.stderr
+        strain[label] = json.loads(report.read_text())["panels"][0]["strain_max"]
+    assert strain["plain"] > 0.95  # a triangle at the pole pressed (nearly) flat
+    assert strain["guarded"] < 0.75  # none below about 0.3 of its size
+    proc = run("flatten", path, "-o", tmp_path / "bad.dxf", "--min-stretch", "1.5")
+    assert proc.returncode == 2 and "min_stretch" in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "bad.dxf").exists()

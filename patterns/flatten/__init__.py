@@ -86,7 +86,7 @@ class Flattening:
 
 def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | None = None,
                  pins=None, max_iterations: int = 500, tolerance: float = 1e-4,
-                 progress=None, name: str = "mesh") -> Flattening:
+                 min_stretch: float | None = None, progress=None, name: str = "mesh") -> Flattening:
     """Flatten a triangle mesh to the plane at true scale.
 
     Parameters
@@ -133,6 +133,14 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
     tolerance : float
         ``"relaxed"`` only: stop when the summed squared edge strain falls by
         less than this fraction per iteration (averaged over two; >= 0).
+    min_stretch : float in (0, 1), optional
+        ``"relaxed"`` only: keep every triangle's smallest principal stretch
+        near or above this (0.3 keeps each triangle at least about 30 % of its
+        size in every direction).  Least squared edge strain alone may press a
+        small region of a dome or a cup nearly flat (measured in
+        docs/benchmarks.md); this adds a guard that is zero until a triangle is
+        squeezed that far.  Parts without such a region come out unchanged; on
+        a hemisphere the edge-strain RMS rises by about 2 %.
     progress : callable, optional
         Called as ``progress(n_done, n_total)``: vertices placed by a grower,
         then iterations of the relaxation.
@@ -158,6 +166,12 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
     # Cheap option checks before the mesh is validated (a second at 1M faces).
     if method != "relaxed" and pins is not None:
         raise InputError(f"{name}: pins apply to method='relaxed' only")
+    if min_stretch is not None:
+        if method != "relaxed":
+            raise InputError(f"{name}: min_stretch applies to method='relaxed' only")
+        if isinstance(min_stretch, bool) or not isinstance(min_stretch, (int, float, np.floating)) \
+                or not 0 < min_stretch < 1:
+            raise InputError(f"{name}: min_stretch must be a number between 0 and 1, got {min_stretch!r}")
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
         raise InputError(f"{name}: max_iterations must be a positive integer, got {max_iterations!r}")
     if not (isinstance(tolerance, (int, float, np.floating)) and tolerance >= 0):
@@ -182,7 +196,7 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
                                  rotations=rotations, progress=None if method == "relaxed" else progress)
     uv = np.column_stack([w.real, w.imag])
     if method == "relaxed":
-        return _relaxed(v, f, conn, uv, seed, z, pins, max_iterations, tolerance, progress)
+        return _relaxed(v, f, conn, uv, seed, z, pins, max_iterations, tolerance, progress, min_stretch)
     # Beyond ~1e154 the flat triangles' areas overflow double precision: such a
     # result cannot even be checked, so it is an error, not an answer.
     with np.errstate(over="ignore", invalid="ignore"):
@@ -203,7 +217,7 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
     )
 
 
-def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progress) -> Flattening:
+def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progress, min_stretch) -> Flattening:
     """Pick a one-to-one start (greedy, else LSCM, else Tutte) and relax it."""
     start, label, barrier = greedy, "greedy", 1e-3
     if not overlap_verdict(f, start, conn.loops).one_to_one:
@@ -216,7 +230,7 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
     if pins is not None:
         start = align_to_pins(start, *pins)  # a rigid motion: still one-to-one
     result = relax(v, f, conn, start, pins=pins, barrier=barrier, max_iterations=max_iterations, tolerance=tolerance,
-                   progress=progress, local=z)
+                   progress=progress, local=z, min_stretch=min_stretch)
     uv = np.array(result.uv)
     return Flattening(
         uv=_readonly(uv),
@@ -234,7 +248,8 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
 
 def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: float = 0.0, k_factor: float = 0.5,
             reference: str = "mid", grain=None, max_strain: float | None = None, max_darts: int = 60,
-            max_iterations: int = 500, tolerance: float = 1e-6, progress=None):
+            max_iterations: int = 500, tolerance: float = 1e-6, min_stretch: float | None = None,
+            progress=None):
     """Lay every panel of a model flat at true scale.
 
     Parameters
@@ -279,6 +294,10 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         that the two flat sides of a seam come out as close as the surface
         allows (on the cup sample 0.091-0.096 % apart, against up to 0.13 %
         at 1e-4), for about 1.5 times the iterations.
+    min_stretch : float in (0, 1), optional
+        ``"relaxed"`` only; see :func:`flatten_mesh`: no triangle pressed below
+        this in any direction (a dome relaxed to 1e-6 without it can lose a
+        tenth of its area at the pole; see docs/benchmarks.md).
     progress : callable, optional
         ``progress(panels_done, n_panels)`` after each panel.
 
@@ -319,9 +338,10 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         else:
             vertices = _offset_along_normals(panel, offset) if offset else panel.vertices
             result = flatten_mesh(vertices, panel.faces, method=method, max_iterations=max_iterations,
-                                  tolerance=tolerance, name=name)
+                                  tolerance=tolerance, min_stretch=min_stretch, name=name)
             if max_strain is not None:
-                result, darts = _with_darts(result, max_strain, max_darts, method, max_iterations, tolerance, name)
+                result, darts = _with_darts(result, max_strain, max_darts, method, max_iterations, tolerance,
+                                            min_stretch, name)
         if panel.name in grains:
             result = _turn_to_grain(result, grains[panel.name])
         flat.append(FlatPanel(panel.name, panel, result, darts=darts))
@@ -338,7 +358,8 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
                    thickness=float(thickness), k_factor=float(k_factor), reference=reference)
 
 
-def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_iterations, tolerance, name):
+def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_iterations, tolerance, min_stretch,
+                name):
     """Cut darts into a flattening until its triangle strain is within ``limit``.
 
     Greedy: each round finds the triangles above the limit, takes the one that
@@ -385,7 +406,7 @@ def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_it
         cut = cut_along(v, f, path, name=name)
         darts.append(path)
         result = flatten_mesh(cut.vertices, cut.faces, method=method, max_iterations=max_iterations,
-                              tolerance=tolerance, name=name)
+                              tolerance=tolerance, min_stretch=min_stretch, name=name)
     return result, tuple(np.asarray(d) for d in darts)
 
 

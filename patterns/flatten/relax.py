@@ -153,7 +153,7 @@ def align_to_pins(uv: np.ndarray, index: np.ndarray, target: np.ndarray) -> np.n
 
 def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np.ndarray, *,
           pins=None, barrier: float = 1e-3, max_iterations: int = 500, tolerance: float = 1e-4,
-          progress=None, local=None) -> Relaxation:
+          progress=None, local=None, min_stretch=None) -> Relaxation:
     """Relax a one-to-one layout towards true edge lengths, keeping it one-to-one.
 
     See the module docstring for the method.
@@ -183,6 +183,11 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     local : (m, 3) complex128, optional
         :func:`patterns.measure.local_coordinates` of the mesh, if already at
         hand (computed otherwise).
+    min_stretch : float in (0, 1), optional
+        Guard against crushed triangles: every stage, the last included, adds
+        ``sum_t w_t max(0, |J_t^-1|^2 - f)**2`` with ``f = 1 + 1 / min_stretch**2``
+        (the value of a triangle squeezed to ``min_stretch`` one way and kept
+        the other), which is zero wherever no triangle is squeezed that far.
 
     Returns
     -------
@@ -222,7 +227,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     # barrier-stiffened refactorisations below, whose weights span up to twelve
     # orders of magnitude, stay in double.
     lu = factorize(system, single=True)
-    energy = _StressBarrier(vertices, faces, e, length, local=local)
+    energy = _StressBarrier(vertices, faces, e, length, local=local, min_stretch=min_stretch)
 
     def refactor(u, mu):
         """The Laplacian with the barrier's curvature added to its weights, factorised."""
@@ -265,8 +270,10 @@ class _StressBarrier:
     scattered by sparse products.
     """
 
-    def __init__(self, vertices, faces, edges, length, *, local=None):
+    def __init__(self, vertices, faces, edges, length, *, local=None, min_stretch=None):
         n = len(vertices)
+        # |J^-1|^2 = 1/s1^2 + 1/s2^2 of a triangle squeezed to min_stretch one way, kept the other.
+        self.guard = 0.0 if not min_stretch else 1.0 + 1.0 / min_stretch**2
         self.faces, self.edges, self.length = faces, edges, length
         self._e0, self._e1 = np.ascontiguousarray(edges[:, 0]), np.ascontiguousarray(edges[:, 1])
         self._f0, self._f1, self._f2 = (np.ascontiguousarray(faces[:, k]) for k in range(3))
@@ -318,8 +325,12 @@ class _StressBarrier:
         k = 2.0 * r * self._inv_length / np.maximum(dl, 1e-300)
         return float(r @ r), self.edge_scatter @ np.column_stack([k * dx, k * dy])
 
-    def barrier(self, u):
-        """``(B, gradient (n, 2))`` of the barrier (``mu = 1``); ``(inf, None)`` if a triangle is folded."""
+    def barrier(self, u, *, floor: float = 0.0):
+        """``(B, gradient (n, 2))`` of the barrier (``mu = 1``); ``(inf, None)`` if a triangle is folded.
+
+        With ``floor > 0`` the guard instead: ``sum_t w_t max(0, |J_t^-1|^2 - floor)**2``,
+        zero on every triangle squeezed less than ``floor`` allows.
+        """
         a, b, c, dd = self._frames(u)
         det_p = a * dd - b * c
         if not np.all(det_p > 0):
@@ -328,8 +339,13 @@ class _StressBarrier:
         pg21, pg22 = c * self.g11 + dd * self.g12, c * self.g12 + dd * self.g22
         norm_j = a * pg11 + b * pg12 + c * pg21 + dd * pg22  # |J|^2 (times nothing: G carries R)
         s = self.det_r2 / (det_p * det_p)
-        ws = self.w * s
-        value = float(ws @ norm_j)
+        if floor > 0:
+            excess = np.maximum(norm_j * s - floor, 0.0)  # |J^-1|^2 beyond the floor
+            value = float(self.w @ (excess * excess))
+            ws = 2.0 * self.w * excess * s
+        else:
+            ws = self.w * s
+            value = float(ws @ norm_j)
         k1 = 2.0 * ws
         k2 = k1 * norm_j / det_p
         # d/dP of |J|^2 det_r^2 / det_p^2 = 2 P G s - 2 |J|^2 s / det_p * cof(P),
@@ -339,8 +355,16 @@ class _StressBarrier:
         return value, self.face_scatter @ np.column_stack([gx, gy])
 
     def parts(self, u, mu):
-        """``(S, grad S, B, grad B)``; B is 0 (gradient None) when ``mu == 0``, inf when folded."""
+        """``(S, grad S, B, grad B)``; B is 0 (gradient None) when ``mu == 0``, inf when folded.
+
+        ``S`` includes the guard against crushed triangles when ``self.guard`` is set.
+        """
         value, grad = self.stress(u)
+        if self.guard:
+            g_value, g_grad = self.barrier(u, floor=self.guard)
+            if g_grad is None:
+                return np.inf, None, np.inf, None
+            value, grad = value + g_value, grad + g_grad
         if mu == 0:
             return value, grad, 0.0, None
         b_value, b_grad = self.barrier(u)
@@ -377,6 +401,8 @@ def _quasi_newton(energy, faces, loops, uv, free, lu, *, refactor, barrier, max_
     def evaluate(u):
         """``(E, grad E on the free vertices, S, grad S, B, grad B)``; E is inf when folded."""
         s_value, s_grad, b_value, b_grad = energy.parts(u, mu)
+        if s_grad is None:  # folded (seen by the guard)
+            return np.inf, None, s_value, s_grad, b_value, b_grad
         if mu == 0:
             return s_value, restrict(s_grad), s_value, s_grad, b_value, b_grad
         if b_grad is None:
