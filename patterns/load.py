@@ -120,6 +120,18 @@ def drop_unused(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np
     return vertices[used], remap[faces], int((~used).sum())
 
 
+def _existing_file(path, suffixes, kind: str) -> tuple[Path, str]:
+    """``(Path, lower-case suffix)`` of an existing file of a known type, else the one-line InputError."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in suffixes:
+        raise InputError(f"{path}: unknown {kind} file type {suffix or '(none)'!r}; "
+                         f"expected one of {', '.join(suffixes)}")
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    return path, suffix
+
+
 def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
     """Read a triangle mesh file.
 
@@ -142,13 +154,7 @@ def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
         Missing or unreadable file, unknown suffix, no triangles, bad values;
         the message names the file.
     """
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in MESH_SUFFIXES:
-        raise InputError(f"{path}: unknown mesh file type {suffix or '(none)'!r}; "
-                         f"expected one of {', '.join(MESH_SUFFIXES)}")
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
+    path, suffix = _existing_file(path, MESH_SUFFIXES, "mesh")
     import trimesh  # heavy; only when a file is read
 
     try:
@@ -193,13 +199,7 @@ def read_cad(path):
     CadError
         The file is empty, corrupt, or holds no shape.
     """
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in CAD_SUFFIXES:
-        raise InputError(f"{path}: unknown CAD file type {suffix or '(none)'!r}; "
-                         f"expected one of {', '.join(CAD_SUFFIXES)}")
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
+    path, suffix = _existing_file(path, CAD_SUFFIXES, "CAD")
     if path.stat().st_size == 0:
         raise CadError(f"{path}: the file is empty")
     from OCP.IFSelect import IFSelect_RetDone

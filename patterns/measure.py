@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .mesh import edge_lengths, side_vectors, unique_ints
+from .mesh import edge_lengths, face_areas, side_vectors, unique_edges
 
 __all__ = [
     "Distortion",
@@ -126,16 +126,6 @@ def folded_faces(faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return np.flatnonzero(~(signed_areas(faces, uv) > 0))
 
 
-def _unique_edges(faces: np.ndarray) -> np.ndarray:
-    """The sorted unique undirected edges ``(e, 2) int64``, ``[:, 0] < [:, 1]``."""
-    a = faces.astype(np.int64).T.ravel()  # corners 0, then 1, then 2
-    b = faces[:, [1, 2, 0]].astype(np.int64).T.ravel()
-    n = int(faces.max()) + 1 if len(faces) else 1
-    # One int64 key per edge, ordered as the (low, high) rows would be.
-    keys = unique_ints(np.minimum(a, b) * n + np.maximum(a, b))
-    return np.column_stack([keys // n, keys % n])
-
-
 def edge_strain(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, edges: np.ndarray | None = None) -> np.ndarray:
     """Edge strain ``|l_flat / l_3d - 1|`` of every edge.
 
@@ -153,7 +143,7 @@ def edge_strain(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, edge
     when computed here).
     """
     if edges is None:
-        edges = _unique_edges(faces)
+        edges = unique_edges(faces)
     l3 = edge_lengths(vertices, edges)
     l2 = np.linalg.norm(uv[edges[:, 1]] - uv[edges[:, 0]], axis=1)
     return np.abs(l2 / l3 - 1.0)
@@ -161,9 +151,7 @@ def edge_strain(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, edge
 
 def area_ratio(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
     """Signed flat area over 3D area, per triangle ``(m,) float64``."""
-    p = vertices[faces]
-    a3 = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-    return signed_areas(faces, uv) / a3
+    return signed_areas(faces, uv) / face_areas(vertices, faces)
 
 
 def boundary_lengths(vertices: np.ndarray, uv: np.ndarray, loops) -> np.ndarray:
@@ -238,8 +226,7 @@ def distortion(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, loops
     with np.errstate(over="ignore", invalid="ignore"):
         strain = edge_strain(vertices, faces, uv)
         sigma = principal_stretches(vertices, faces, uv)
-        p = vertices[faces]
-        a3 = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+        a3 = face_areas(vertices, faces)
         sa = signed_areas(faces, uv)
         if loops is None:
             b3 = bf = float("nan")
@@ -319,8 +306,7 @@ def triangle_strains(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) ->
     # (arg alpha + arg beta) / 2, least at right angles to it.
     angle = 0.5 * (np.angle(alpha) + np.angle(beta)) + np.where(first, 0.0, 0.5 * np.pi)
     direction = np.mod(angle, np.pi)
-    p = vertices[faces]
-    a3 = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    a3 = face_areas(vertices, faces)
     change = signed_areas(faces, uv) / a3 - 1.0
     arrays = [stretch, strain, dominant, direction, change, a3]
     for x in arrays:

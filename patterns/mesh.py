@@ -32,6 +32,7 @@ __all__ = [
     "face_areas",
     "side_vectors",
     "trace_loops",
+    "unique_edges",
     "unique_ints",
     "validate_mesh",
 ]
@@ -210,6 +211,20 @@ def unique_ints(values, *, return_index: bool = False, return_inverse: bool = Fa
         inverse[order] = np.cumsum(starts) - 1
         out.append(inverse)
     return out[0] if len(out) == 1 else tuple(out)
+
+
+def unique_edges(faces: np.ndarray) -> np.ndarray:
+    """The sorted unique undirected edges of a triangle list, ``(e, 2) int64``, ``[:, 0] < [:, 1]``.
+
+    No checks (see :func:`edge_tables` for a validated table with the faces of
+    each edge).
+    """
+    a = faces.astype(np.int64).T.ravel()  # corners 0, then 1, then 2
+    b = faces[:, [1, 2, 0]].astype(np.int64).T.ravel()
+    n = int(faces.max()) + 1 if len(faces) else 1
+    # One int64 key per edge, ordered as the (low, high) rows would be.
+    keys = unique_ints(np.minimum(a, b) * n + np.maximum(a, b))
+    return np.column_stack([keys // n, keys % n])
 
 
 def edge_lengths(points: np.ndarray, edges: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ from enum import Enum
 
 import numpy as np
 
-from .mesh import _readonly
+from .mesh import _readonly, face_areas
 
 __all__ = ["Model", "Panel", "Seam", "Surface", "SurfaceKind"]
 
@@ -100,8 +100,7 @@ class Panel:
     @property
     def area(self) -> float:
         """Area of the triangles, mm^2."""
-        p = self.vertices[self.faces]
-        return float(0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum())
+        return float(face_areas(self.vertices, self.faces).sum())
 
 
 @dataclass(frozen=True, eq=False)

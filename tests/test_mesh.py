@@ -146,8 +146,7 @@ def test_column_helpers_match_the_row_formulas():
 
 def test_sort_based_unique_matches_numpy():
     from patterns.load import _unique_rows
-    from patterns.measure import _unique_edges
-    from patterns.mesh import unique_ints
+    from patterns.mesh import unique_edges, unique_ints
 
     rng = np.random.default_rng(2)
     for size in (0, 1, 7, 5000):
@@ -165,4 +164,4 @@ def test_sort_based_unique_matches_numpy():
     assert len(first) == len(v)
     # Edges: the sorted unique (low, high) pairs.
     e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
-    assert np.array_equal(_unique_edges(f), np.unique(e, axis=0))
+    assert np.array_equal(unique_edges(f), np.unique(e, axis=0))

@@ -14,8 +14,8 @@ import numpy as np
 
 from ..check import Overlap, overlap_verdict
 from ..errors import FlattenError, InputError
-from ..measure import Distortion, _unique_edges, distortion, local_coordinates, signed_areas
-from ..mesh import _readonly, unique_ints, validate_mesh
+from ..measure import Distortion, distortion, local_coordinates, signed_areas
+from ..mesh import _readonly, unique_edges, unique_ints, validate_mesh
 from . import grow
 from .embed import lscm, tutte_embedding
 from .relax import align_to_pins, best_scale, check_pins, relax
@@ -381,7 +381,7 @@ def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_it
         if not len(above):
             break
         n = len(v)
-        edges = _unique_edges(f)
+        edges = unique_edges(f)
         weight = np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)
         graph = sp.coo_matrix((np.r_[weight, weight], (np.r_[edges[:, 0], edges[:, 1]],
                                                         np.r_[edges[:, 1], edges[:, 0]])), shape=(n, n)).tocsr()

@@ -273,7 +273,7 @@ class _StressBarrier:
     def __init__(self, vertices, faces, edges, length, *, local=None, min_stretch=None):
         n = len(vertices)
         # |J^-1|^2 = 1/s1^2 + 1/s2^2 of a triangle squeezed to min_stretch one way, kept the other.
-        self.guard = 0.0 if not min_stretch else 1.0 + 1.0 / min_stretch**2
+        self.floor = 0.0 if not min_stretch else 1.0 + 1.0 / min_stretch**2
         self.faces, self.edges, self.length = faces, edges, length
         self._e0, self._e1 = np.ascontiguousarray(edges[:, 0]), np.ascontiguousarray(edges[:, 1])
         self._f0, self._f1, self._f2 = (np.ascontiguousarray(faces[:, k]) for k in range(3))
@@ -297,18 +297,22 @@ class _StressBarrier:
             (np.r_[np.ones(2 * m), -np.ones(2 * m)],
              (np.r_[self._f1, self._f2, self._f0, self._f0], np.r_[cols, cols])), shape=(n, 2 * m))
 
-    def _frames(self, u):
-        """Columns of each triangle's flat edge matrix ``P = [[a, b], [c, d]]``."""
+    def _jacobian(self, u):
+        """Per-triangle ``(P columns a, b, c, d; det P; P G entries; |J|^2)`` of the flat map."""
         x, y = u[:, 0], u[:, 1]
         x0, y0 = x.take(self._f0), y.take(self._f0)
-        return x.take(self._f1) - x0, x.take(self._f2) - x0, y.take(self._f1) - y0, y.take(self._f2) - y0
+        a, b = x.take(self._f1) - x0, x.take(self._f2) - x0  # P = [[a, b], [c, d]]
+        c, dd = y.take(self._f1) - y0, y.take(self._f2) - y0
+        det_p = a * dd - b * c
+        pg11, pg12 = a * self.g11 + b * self.g12, a * self.g12 + b * self.g22
+        pg21, pg22 = c * self.g11 + dd * self.g12, c * self.g12 + dd * self.g22
+        norm_j = a * pg11 + b * pg12 + c * pg21 + dd * pg22  # |J|^2 (times nothing: G carries R)
+        return a, b, c, dd, det_p, (pg11, pg12, pg21, pg22), norm_j
 
     def barrier_stiffness(self, u, mu):
         """Per-triangle curvature scale of the barrier term, ``(m,)``: ``mu w 6 / sigma_min**4``."""
-        a, b, c, dd = self._frames(u)
-        det2 = (a * dd - b * c) ** 2 / self.det_r2  # det(J)**2
-        norm_j = a * (a * self.g11 + b * self.g12) + b * (a * self.g12 + b * self.g22) + \
-            c * (c * self.g11 + dd * self.g12) + dd * (c * self.g12 + dd * self.g22)
+        *_, det_p, _, norm_j = self._jacobian(u)
+        det2 = det_p * det_p / self.det_r2  # det(J)**2
         # Smallest singular value squared, in the cancellation-free form
         # det**2 / (largest one squared).
         smin2 = 2.0 * det2 / (norm_j + np.sqrt(np.maximum(norm_j * norm_j - 4.0 * det2, 0.0)))
@@ -325,19 +329,22 @@ class _StressBarrier:
         k = 2.0 * r * self._inv_length / np.maximum(dl, 1e-300)
         return float(r @ r), self.edge_scatter @ np.column_stack([k * dx, k * dy])
 
-    def barrier(self, u, *, floor: float = 0.0):
-        """``(B, gradient (n, 2))`` of the barrier (``mu = 1``); ``(inf, None)`` if a triangle is folded.
+    def barrier(self, u):
+        """``(B, gradient (n, 2))`` of the barrier (``mu = 1``); ``(inf, None)`` if a triangle is folded."""
+        return self._inverse_term(u, 0.0)
 
-        With ``floor > 0`` the guard instead: ``sum_t w_t max(0, |J_t^-1|^2 - floor)**2``,
-        zero on every triangle squeezed less than ``floor`` allows.
+    def guard(self, u):
+        """``(sum_t w_t max(0, |J_t^-1|^2 - floor)**2, gradient (n, 2))``; ``(inf, None)`` if folded.
+
+        Zero on every triangle squeezed less than ``min_stretch`` allows.
         """
-        a, b, c, dd = self._frames(u)
-        det_p = a * dd - b * c
+        return self._inverse_term(u, self.floor)
+
+    def _inverse_term(self, u, floor):
+        """The barrier (``floor == 0``) or the guard, with its gradient."""
+        a, b, c, dd, det_p, (pg11, pg12, pg21, pg22), norm_j = self._jacobian(u)
         if not np.all(det_p > 0):
             return np.inf, None
-        pg11, pg12 = a * self.g11 + b * self.g12, a * self.g12 + b * self.g22
-        pg21, pg22 = c * self.g11 + dd * self.g12, c * self.g12 + dd * self.g22
-        norm_j = a * pg11 + b * pg12 + c * pg21 + dd * pg22  # |J|^2 (times nothing: G carries R)
         s = self.det_r2 / (det_p * det_p)
         if floor > 0:
             excess = np.maximum(norm_j * s - floor, 0.0)  # |J^-1|^2 beyond the floor
@@ -357,11 +364,11 @@ class _StressBarrier:
     def parts(self, u, mu):
         """``(S, grad S, B, grad B)``; B is 0 (gradient None) when ``mu == 0``, inf when folded.
 
-        ``S`` includes the guard against crushed triangles when ``self.guard`` is set.
+        ``S`` includes the guard against crushed triangles when ``min_stretch`` was given.
         """
         value, grad = self.stress(u)
-        if self.guard:
-            g_value, g_grad = self.barrier(u, floor=self.guard)
+        if self.floor:
+            g_value, g_grad = self.guard(u)
             if g_grad is None:
                 return np.inf, None, np.inf, None
             value, grad = value + g_value, grad + g_grad
