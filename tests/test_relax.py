@@ -216,32 +216,83 @@ def test_heads_relax_far_below_their_conformal_start(name):
     assert r.distortion.edge_strain_rms < 0.45
 
 
-def test_refactorisation_reusing_the_ordering_solves_the_same_system():
-    """The relaxation refactorises its preconditioner with the first factor's
-    elimination order; the solution must be the one of a fresh factorisation."""
+def test_ldl_refactorisations_solve_each_new_system_and_refuse_stale_factors():
+    """The relaxation refactorises its preconditioner numerically only (qdldl,
+    ordering kept); every refactorisation must solve its own matrix, the
+    Laplacian's free block as ``_laplacian`` builds it, with and without pins."""
     import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
 
-    from patterns.flatten.embed import factorize
-    from patterns.flatten.relax import _laplacian
+    from patterns.flatten.relax import _laplacian, _StiffLaplacian
 
     v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=3000)
     v, f, conn = validate_mesh(v, f)
     e = conn.edges
     n = len(v)
     w = 1.0 / np.linalg.norm(v[e[:, 1]] - v[e[:, 0]], axis=1) ** 2
-    first = factorize(_laplacian(n, e, w, anchor=float(w.mean())))
     rng = np.random.default_rng(5)
-    w2 = w * rng.uniform(1.0, 50.0, size=len(w))  # other numbers, the same pattern
-    matrix = _laplacian(n, e, w2, anchor=float(w.mean()))
-    b = rng.normal(size=(n, 2))
-    reused = factorize(matrix, like=first).solve(b)
-    fresh = factorize(matrix).solve(b)
-    assert np.allclose(reused, fresh, rtol=0, atol=1e-9 * np.abs(fresh).max())
-    assert np.allclose(sp.csr_matrix(matrix) @ reused, b, rtol=0, atol=1e-8 * np.abs(b).max())
+    pinned = np.zeros(n, dtype=bool)
+    pinned[rng.choice(n, 7, replace=False)] = True
+    for free, anchor in ((np.ones(n, dtype=bool), float(w.mean())), (~pinned, 0.0)):
+        stiff = _StiffLaplacian(e, free, anchor=anchor)
+        b = rng.normal(size=(int(free.sum()), 2))
+        factors = []
+        for spread in (1.0, 50.0, 1e6):  # other numbers, the same pattern; up to six orders apart
+            w2 = w * rng.uniform(1.0, spread, size=len(w))
+            matrix = sp.csc_matrix(_laplacian(n, e, w2, anchor=anchor)[free][:, free])
+            factor = stiff.factorize(w2)
+            x = factor.solve(b)
+            # Backward error at round-off level (the anchored Laplacian is
+            # ill-conditioned, so forward errors are compared loosely).
+            scale = spla.norm(matrix, np.inf) * np.abs(x).max() + np.abs(b).max()
+            assert np.abs(matrix @ x - b).max() < 1e-13 * scale
+            exact = spla.spsolve(matrix, b)
+            assert np.linalg.norm(x - exact) < 1e-5 * np.linalg.norm(exact)
+            assert np.allclose(factor.solve(b[:, 0]), x[:, 0], rtol=0, atol=1e-12 * np.abs(x).max())
+            factors.append(factor)
+        for stale in factors[:-1]:  # overwritten in place: refuses rather than answering wrongly
+            with pytest.raises(RuntimeError, match="overwritten"):
+                stale.solve(b)
     # The Laplacian itself: rows sum to zero except the anchored vertex 0.
+    matrix = _laplacian(n, e, w, anchor=float(w.mean()))
     row_sums = np.asarray(matrix.sum(axis=1)).ravel()
     assert row_sums[0] == pytest.approx(w.mean(), rel=1e-12)
-    assert np.abs(row_sums[1:]).max() < 1e-9 * w2.max()
+    assert np.abs(row_sums[1:]).max() < 1e-9 * w.max()
+
+
+def test_lscm_solves_the_real_least_squares_problem():
+    """LSCM is solved as an n x n Hermitian system; it must be the minimiser of
+    the real 2n-unknown least-squares problem of Levy et al., solved here
+    independently by dense least squares."""
+    from patterns.measure import local_coordinates
+
+    v, f = surfaces.ellipsoid_cup(n_faces=600)
+    v, f, conn = validate_mesh(v, f)
+    uv = lscm(v, f, conn)
+    n, m = len(v), len(f)
+    z = local_coordinates(v, f)
+    area = np.abs((np.conj(z[:, 1]) * z[:, 2]).imag) / 2
+    # Gradient of the linear interpolant of corner values, as u_x + i u_y.
+    grad = np.stack([z[:, 2] - z[:, 1], z[:, 0] - z[:, 2], z[:, 1] - z[:, 0]], axis=1)
+    grad = 1j * grad / (2 * area)[:, None]  # the opposite side turned a quarter, over 2 A
+    rows = np.zeros((2 * m, 2 * n))
+    for k in range(3):
+        gx, gy = grad[:, k].real, grad[:, k].imag
+        s = np.sqrt(area)
+        np.add.at(rows, (np.arange(m), 2 * f[:, k]), s * gx)  # u_x - v_y
+        np.add.at(rows, (np.arange(m), 2 * f[:, k] + 1), -s * gy)
+        np.add.at(rows, (m + np.arange(m), 2 * f[:, k]), s * gy)  # u_y + v_x
+        np.add.at(rows, (m + np.arange(m), 2 * f[:, k] + 1), s * gx)
+    # The same two pins as lscm: take them from its result (u = 0 and the far one on +u).
+    p0 = int(np.flatnonzero(np.all(np.abs(uv) < 1e-12, axis=1))[0])
+    p1 = int(np.argmax(np.where(np.abs(uv[:, 1]) < 1e-12, uv[:, 0], -np.inf)))
+    fixed = np.array([2 * p0, 2 * p0 + 1, 2 * p1, 2 * p1 + 1])
+    free = np.setdiff1d(np.arange(2 * n), fixed)
+    values = np.array([0.0, 0.0, uv[p1, 0], 0.0])
+    x = np.zeros(2 * n)
+    x[fixed] = values
+    x[free] = np.linalg.lstsq(rows[:, free], -rows[:, fixed] @ values, rcond=None)[0]
+    assert np.abs(x.reshape(n, 2) - uv).max() < 1e-9 * np.ptp(uv, axis=0).max()
 
 
 def test_single_precision_factor_is_a_close_unit_free_preconditioner():

@@ -374,11 +374,14 @@ def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_it
     from ..measure import triangle_strains
 
     darts = []
-    for _ in range(max_darts):
+    best = (np.inf, result, 0)  # (worst strain, flattening, darts so far)
+    for _ in range(max_darts + 1):
         v, f = result.vertices, result.faces
         mag = triangle_strains(v, f, result.uv).magnitude
+        if mag.max() < best[0]:
+            best = (float(mag.max()), result, len(darts))
         above = np.flatnonzero(mag > limit)
-        if not len(above):
+        if not len(above) or len(darts) == max_darts:
             break
         n = len(v)
         edges = unique_edges(f)
@@ -407,7 +410,10 @@ def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_it
         darts.append(path)
         result = flatten_mesh(cut.vertices, cut.faces, method=method, max_iterations=max_iterations,
                               tolerance=tolerance, min_stretch=min_stretch, name=name)
-    return result, tuple(np.asarray(d) for d in darts)
+    # The darts are chosen greedily and each flattening is a local optimum: a
+    # later round can come out worse than an earlier one.  Keep the best.
+    _, result, kept = best
+    return result, tuple(np.asarray(d) for d in darts[:kept])
 
 
 def _grain_table(grain, model) -> dict:

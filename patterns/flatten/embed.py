@@ -20,63 +20,45 @@ import scipy.sparse.linalg as spla
 
 from ..mesh import Connectivity
 
-__all__ = ["Factor", "factorize", "lscm", "tutte_embedding"]
+__all__ = ["LDL", "Factor", "LDLFactor", "factorize", "lscm", "tutte_embedding"]
 
 
 class Factor:
-    """A sparse LU factorisation of a symmetric positive definite ``(n, n)`` matrix.
+    """A sparse LU factorisation of a symmetric (or Hermitian) positive definite ``(n, n)`` matrix."""
 
-    Attributes
-    ----------
-    order : (n,) int64
-        The fill-reducing elimination order (row/column ``order[k]`` is
-        eliminated ``k``-th); a later matrix of the same pattern can reuse it
-        (:func:`factorize`'s ``like``).
-    """
-
-    def __init__(self, lu, order: np.ndarray, permuted: bool, scale: float = 0.0):
-        self._lu, self.order, self._permuted, self._scale = lu, order, permuted, scale
+    def __init__(self, lu, scale: float = 0.0):
+        self._lu, self._scale = lu, scale
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """``A^-1 b`` for ``b`` of shape ``(n,)`` or ``(n, k)``, float64 in and out."""
-        if self._scale:
-            # Single precision: the right-hand side goes in at unit size, so
-            # that the rounding -- and the result -- does not depend on the unit.
-            size = float(np.abs(b).max()) or 1.0
-            rhs = (b / size).astype(np.float32)
-            factor = size / self._scale
-        else:
-            rhs, factor = b, 1.0
-        if self._permuted:
-            x = np.empty(b.shape)
-            x[self.order] = self._lu.solve(rhs[self.order])
-        else:
-            x = self._lu.solve(rhs).astype(np.float64, copy=False)
-        return x * factor if self._scale else x
+        """``A^-1 b`` for ``b`` of shape ``(n,)`` or ``(n, k)``, in the matrix's dtype (float64 if single)."""
+        if not self._scale:
+            return self._lu.solve(b)
+        # Single precision: the right-hand side goes in at unit size, so that
+        # the rounding -- and the result -- does not depend on the unit.
+        size = float(np.abs(b).max()) or 1.0
+        x = self._lu.solve((b / size).astype(np.float32))
+        return x.astype(np.float64) * (size / self._scale)
 
 
-def factorize(matrix: sp.spmatrix, *, like: Factor | None = None, single: bool = False) -> Factor:
-    """Sparse LU of a symmetric positive definite matrix, minimum-degree ordered.
+def factorize(matrix: sp.spmatrix, *, single: bool = False) -> Factor:
+    """Sparse LU of a symmetric or Hermitian positive definite matrix, minimum-degree ordered.
 
     Parameters
     ----------
-    matrix : (n, n) sparse
-    like : Factor, optional
-        A factorisation of a matrix with the same sparsity pattern: its
-        elimination order is reused, so only the numbers are factorised (the
-        relaxation refactorises its preconditioner this way).
+    matrix : (n, n) sparse, float64 or complex128
     single : bool
-        Factorise in single precision (float32): about a third faster to
-        factorise and to solve with, for a preconditioner that need not be
-        exact.  :meth:`Factor.solve` still takes and returns float64.
+        Factorise in single precision (float32; real matrices only): about a
+        third faster to factorise and to solve with, for a preconditioner that
+        need not be exact.  :meth:`Factor.solve` still takes and returns float64.
 
     Returns
     -------
     Factor
+
+    See Also
+    --------
+    LDL : numeric-only refactorisations of matrices of one pattern.
     """
-    # Panels of 4 columns (SuperLU's default is 10) factorise these mesh
-    # Laplacians about a fifth faster; the factor itself is the same.
-    options = {"SymmetricMode": True}
     matrix = sp.csc_matrix(matrix)
     scale = 0.0
     if single:
@@ -84,13 +66,74 @@ def factorize(matrix: sp.spmatrix, *, like: Factor | None = None, single: bool =
         # in any unit (a mesh in inches factorises like the same mesh in mm).
         scale = float(np.abs(matrix.diagonal()).mean())
         matrix = sp.csc_matrix(matrix / scale, dtype=np.float32)
-    if like is None:
-        lu = spla.splu(matrix, permc_spec="MMD_AT_PLUS_A", panel_size=4, options=options, diag_pivot_thresh=0.0)
-        return Factor(lu, np.argsort(lu.perm_c), False, scale)
-    order = like.order
-    lu = spla.splu(matrix[order][:, order].tocsc(), permc_spec="NATURAL", panel_size=4, options=options,
+    # Panels of 4 columns (SuperLU's default is 10) factorise these mesh
+    # Laplacians about a fifth faster; the factor itself is the same.
+    lu = spla.splu(matrix, permc_spec="MMD_AT_PLUS_A", panel_size=4, options={"SymmetricMode": True},
                    diag_pivot_thresh=0.0)
-    return Factor(lu, order, True, scale)
+    return Factor(lu, scale)
+
+
+class LDL:
+    """Repeated ``L D L^T`` factorisations of symmetric positive definite matrices of one pattern.
+
+    The ordering (AMD) and the elimination tree are computed once, from the
+    pattern; :meth:`factorize` then factorises only the numbers (qdldl).  On
+    Aphrodite's 55 598-vertex Laplacian a refactorisation takes 0.06 s, where
+    SuperLU took 0.18 s even with the elimination order given.  A solver
+    object in the sense of potpourri3d: the set-up is the part worth keeping.
+
+    Parameters
+    ----------
+    n : int
+        Matrix size.
+    rows, cols : (k,) int64
+        The upper triangle's entries (``rows <= cols``), each once, the
+        diagonal included; the order in which :meth:`factorize` takes values.
+
+    Notes
+    -----
+    The factor is overwritten in place: a :class:`LDLFactor` from an earlier
+    :meth:`factorize` call refuses to solve (``RuntimeError``) instead of
+    silently solving with the newer matrix.
+    """
+
+    def __init__(self, n: int, rows: np.ndarray, cols: np.ndarray):
+        marker = np.arange(1, len(rows) + 1, dtype=np.float64)
+        upper = sp.csc_matrix((marker, (rows, cols)), shape=(n, n))
+        self._slot = upper.data.astype(np.int64) - 1  # CSC position -> input position
+        self._indices, self._indptr, self._n = upper.indices, upper.indptr, n
+        self._solver = None
+        self._generation = 0
+
+    def factorize(self, values: np.ndarray) -> LDLFactor:
+        """Factorise the matrix with these upper-triangle ``values`` ``(k,) float64``."""
+        import qdldl
+
+        upper = sp.csc_matrix((np.asarray(values, dtype=np.float64)[self._slot], self._indices, self._indptr),
+                              shape=(self._n, self._n))
+        if self._solver is None:
+            self._solver = qdldl.Solver(upper, upper=True)
+        else:
+            self._solver.update(upper, upper=True)
+        self._generation += 1
+        return LDLFactor(self, self._generation)
+
+
+class LDLFactor:
+    """The latest factorisation of an :class:`LDL`; valid until its next :meth:`LDL.factorize`."""
+
+    def __init__(self, owner: LDL, generation: int):
+        self._owner, self._generation = owner, generation
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """``A^-1 b`` for ``b`` of shape ``(n,)`` or ``(n, k)``, float64."""
+        if self._generation != self._owner._generation:
+            raise RuntimeError("this factor was overwritten by a later LDL.factorize")
+        solver = self._owner._solver
+        b = np.asarray(b, dtype=np.float64)
+        if b.ndim == 1:
+            return solver.solve(b)
+        return np.column_stack([solver.solve(np.ascontiguousarray(b[:, k])) for k in range(b.shape[1])])
 
 
 def tutte_embedding(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity) -> np.ndarray:
@@ -160,26 +203,24 @@ def lscm(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, *, local: 
 
     n, m = len(vertices), len(faces)
     z = local_coordinates(vertices, faces) if local is None else local
+    # A triangle's Cauchy-Riemann residual (u_x - v_y) + i (u_y + v_x) is
+    # complex-linear in its corners' flat positions u + i v: sum_k w_k z_k.  So
+    # the energy is |W z|^2 with W complex (m, n), and its minimiser solves an
+    # n x n Hermitian system -- a third of the time of the equivalent real
+    # 2n x 2n one (the same answer to round-off).
     weight = np.stack([z[:, 2] - z[:, 1], z[:, 0] - z[:, 2], z[:, 1] - z[:, 0]], axis=1)
     weight /= np.sqrt(np.abs((np.conj(z[:, 1]) * z[:, 2]).imag))[:, None]
-    rows = np.repeat(np.arange(m), 3)
-    cu = 2 * faces.ravel()  # unknowns interleaved, u0 v0 u1 v1 ...: a tighter factor
-    cv = cu + 1
-    a, b = weight.real.ravel(), weight.imag.ravel()
-    # Rows 0..m-1: real part (a u - b v); rows m..2m-1: imaginary part (a v + b u).
-    system = sp.coo_matrix(
-        (np.r_[a, -b, b, a], (np.r_[rows, rows, rows + m, rows + m], np.r_[cu, cv, cu, cv])),
-        shape=(2 * m, 2 * n),
-    ).tocsc()
+    system = sp.csc_matrix((weight.ravel(), (np.repeat(np.arange(m), 3), faces.ravel())), shape=(m, n))
     loop = conn.loops[0]
     p0 = loop[np.argmax(np.linalg.norm(vertices[loop] - vertices[loop[0]], axis=1))]
     p1 = loop[np.argmax(np.linalg.norm(vertices[loop] - vertices[p0], axis=1))]
-    fixed = np.array([2 * p0, 2 * p1, 2 * p0 + 1, 2 * p1 + 1])
-    values = np.array([0.0, np.linalg.norm(vertices[p1] - vertices[p0]), 0.0, 0.0])
-    free = np.ones(2 * n, dtype=bool)
+    fixed = np.array([p0, p1])
+    values = np.array([0.0, np.linalg.norm(vertices[p1] - vertices[p0])], dtype=np.complex128)
+    free = np.ones(n, dtype=bool)
     free[fixed] = False
     a_free, a_fixed = system[:, free], system[:, fixed]
-    x = np.zeros(2 * n)
+    adjoint = a_free.conj().T
+    x = np.zeros(n, dtype=np.complex128)
     x[fixed] = values
-    x[free] = factorize(a_free.T @ a_free).solve(-(a_free.T @ (a_fixed @ values)))
-    return x.reshape(n, 2)
+    x[free] = factorize(adjoint @ a_free).solve(-(adjoint @ (a_fixed @ values)))
+    return np.column_stack([x.real, x.imag])

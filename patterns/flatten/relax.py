@@ -22,8 +22,9 @@ Method
   answer), factorised once with SuperLU (in single precision: it only shapes
   the steps).  While the barrier is strong its curvature is added to the
   weights every few iterations and the matrix refactorised in double
-  precision, reusing the first elimination order (a scalar version of SLIM's
-  proxy).  One solve per iteration; the L-BFGS memory is kept until the
+  precision by qdldl's ``L D L^T``, whose ordering and elimination tree are
+  kept from the first refactorisation so that only the numbers are factorised
+  (:class:`~patterns.flatten.embed.LDL`; a scalar version of SLIM's proxy).  One solve per iteration; the L-BFGS memory is kept until the
   matrix changes.
 * **Line search.**  Each step is capped at 0.9 of the first time any triangle
   would flip (exact quadratic roots, :func:`flip_free_steps`), then halved until
@@ -47,7 +48,7 @@ from ..check import crossing_segments
 from ..errors import InputError
 from ..measure import local_coordinates, signed_areas
 from ..mesh import Connectivity, edge_lengths
-from .embed import factorize
+from .embed import LDL, LDLFactor, factorize
 
 _WINDOW = 2  # iterations over which progress is judged
 _STAGE_TOLERANCE = 30.0  # a barrier stage ends at this many times the tolerance
@@ -228,6 +229,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     # orders of magnitude, stay in double.
     lu = factorize(system, single=True)
     energy = _StressBarrier(vertices, faces, e, length, local=local, min_stretch=min_stretch)
+    stiffened = []  # the _StiffLaplacian, made at the first refactorisation
 
     def refactor(u, mu):
         """The Laplacian with the barrier's curvature added to its weights, factorised."""
@@ -239,12 +241,9 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
             # The barrier at most doubles the curvature of under a tenth of the
             # edges (a few squeezed triangles): not worth a factorisation.
             return lu
-        w = weight * (1.0 + 0.5 * extra)
-        if pins is None:
-            lap = _laplacian(n, e, w, anchor=anchor)
-        else:
-            lap = _laplacian(n, e, w)[free][:, free]
-        return factorize(lap, like=lu)  # same pattern: the first ordering serves
+        if not stiffened:
+            stiffened.append(_StiffLaplacian(e, free, anchor=anchor if pins is None else 0.0))
+        return stiffened[0].factorize(weight * (1.0 + 0.5 * extra))
 
     uv, used, converged = _quasi_newton(energy, faces, conn.loops, uv, free, lu, refactor=refactor, barrier=barrier,
                                         max_iterations=max_iterations - iterations, tolerance=tolerance,
@@ -538,6 +537,32 @@ def _travel_to_pins(faces, loops, e, length, weight, laplacian, free, uv, pin_in
             break
         uv = moved
     return np.array(uv), iterations
+
+
+class _StiffLaplacian:
+    """The weighted Laplacian's free block, refactorised for new edge weights.
+
+    The same matrix as ``_laplacian(n, edges, weight, anchor=anchor)[free][:, free]``;
+    the pattern never changes, so an :class:`~patterns.flatten.embed.LDL` keeps
+    its ordering and elimination tree and each refactorisation is numeric only.
+    Each :meth:`factorize` overwrites the previous factor.
+    """
+
+    def __init__(self, edges: np.ndarray, free: np.ndarray, *, anchor: float = 0.0):
+        n, k = len(free), int(free.sum())
+        index = np.cumsum(free) - 1
+        self._inner = free[edges[:, 0]] & free[edges[:, 1]]
+        a, b = index[edges[self._inner, 0]], index[edges[self._inner, 1]]
+        node = np.arange(k)
+        self._ldl = LDL(k, np.r_[np.minimum(a, b), node], np.r_[np.maximum(a, b), node])
+        self._edges, self._free, self._n, self._anchor = edges, free, n, anchor
+
+    def factorize(self, weight: np.ndarray) -> LDLFactor:
+        """Factorise with edge weights ``weight`` ``(k,) float64``."""
+        e0, e1 = self._edges[:, 0], self._edges[:, 1]
+        diagonal = np.bincount(e0, weight, self._n) + np.bincount(e1, weight, self._n)
+        diagonal[0] += self._anchor
+        return self._ldl.factorize(np.r_[-weight[self._inner], diagonal[self._free]])
 
 
 def _laplacian(n: int, edges: np.ndarray, weight: np.ndarray, *, anchor: float = 0.0) -> sp.csc_matrix:
