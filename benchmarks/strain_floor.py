@@ -76,10 +76,8 @@ def descend(f, start: np.ndarray) -> np.ndarray:
     return res.x.reshape(-1, 2)
 
 
-def starts(vertices, faces, relaxed_uv, mean_edge, noisy: int, rng):
+def starts(vertices, faces, edges, relaxed_uv, arap, init, mean_edge, noisy: int, rng):
     """Named start layouts: the four methods, then their noisy copies."""
-    arap, init, _ = bench.igl_arap(vertices, faces)
-    edges = unique_edges(faces)
     init = np.asarray(init, dtype=np.float64)
     init = init * best_scale(vertices, edges, init)
     lscm, _ = bench.area_normalise(vertices, faces, bench.igl_lscm(vertices, faces))
@@ -121,11 +119,12 @@ def main(argv=None) -> int:
         edges = unique_edges(f_)
         length = np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)
         energy = strain_energy(edges, length)
-        arap = np.asarray(bench.igl_arap(v, f_)[0], dtype=np.float64)
+        arap, init, _ = bench.igl_arap(v, f_)
+        arap = np.asarray(arap, dtype=np.float64)
         arap_rms = rms(energy, arap, len(edges))
         relaxed_rms = rms(energy, uv0, len(edges))
         found = []
-        for label, start in starts(v, f_, uv0, float(length.mean()), args.noisy, rng):
+        for label, start in starts(v, f_, edges, uv0, arap, init, float(length.mean()), args.noisy, rng):
             end = descend(energy, start)
             found.append((rms(energy, end, len(edges)), label, end))
         found.sort(key=lambda item: item[0])

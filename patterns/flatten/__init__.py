@@ -380,37 +380,21 @@ def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_it
     darts that raise it for a round are often what brings it down later.
     Returns ``(flattening, darts)``.
     """
-    import scipy.sparse as sp
-    from scipy.sparse import csgraph
-
     from ..cut import cut_along
-    from ..measure import triangle_strains
 
     darts = []
     lowest = result.distortion.edge_strain_rms
     refused = set()  # target vertices whose dart made things worse (indices survive later cuts)
     in_a_row = 0
-    while len(darts) < max_darts and in_a_row < _DART_REFUSALS:
-        v, f = result.vertices, result.faces
-        mag = triangle_strains(v, f, result.uv).magnitude
-        above = np.flatnonzero(mag > limit)
-        if not len(above):
-            break
-        n = len(v)
-        edges = unique_edges(f)
-        weight = np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)
-        graph = sp.coo_matrix((np.r_[weight, weight], (np.r_[edges[:, 0], edges[:, 1]],
-                                                        np.r_[edges[:, 1], edges[:, 0]])), shape=(n, n)).tocsr()
-        boundary = unique_ints(np.concatenate(result.loops))
-        dist, pred, _ = csgraph.dijkstra(graph, indices=boundary, min_only=True, return_predecessors=True)
+    depths = _strained_depths(result, limit)  # recomputed only when a dart is kept
+    while depths is not None and len(darts) < max_darts and in_a_row < _DART_REFUSALS:
+        strained, dist, pred = depths
         # The vertex to cut to: among the vertices next to a triangle above the
         # limit, the one deepest inside (farthest from the outline along the
         # mesh), so that one dart relieves the whole strained run.
-        strained = np.zeros(n, dtype=bool)
-        strained[f[above].ravel()] = True
-        strained[boundary] = False
-        strained[list(refused)] = False
-        candidates = np.flatnonzero(strained & np.isfinite(dist))
+        open_to = strained.copy()
+        open_to[list(refused)] = False
+        candidates = np.flatnonzero(open_to)
         if not len(candidates):
             break  # every strained triangle lies on the outline (or was tried): nothing left to cut
         target = int(candidates[np.argmax(dist[candidates])])
@@ -418,17 +402,47 @@ def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_it
         while pred[path[-1]] >= 0:
             path.append(int(pred[path[-1]]))
         path = np.asarray(path[::-1], dtype=np.int64)  # from the outline inwards
-        cut = cut_along(v, f, path, name=name)
+        cut = cut_along(result.vertices, result.faces, path, name=name)
         after = flatten_mesh(cut.vertices, cut.faces, method=method, max_iterations=max_iterations,
                              tolerance=tolerance, min_stretch=min_stretch, name=name)
         rms = after.distortion.edge_strain_rms
         if rms <= _DART_SLACK * lowest:
             darts.append(path)
             result, lowest, in_a_row = after, min(lowest, rms), 0
+            depths = _strained_depths(result, limit)
         else:
             refused.add(target)
             in_a_row += 1
     return result, tuple(np.asarray(d) for d in darts)
+
+
+def _strained_depths(result: Flattening, limit: float):
+    """Where a dart could go: ``(strained (n,) bool, dist (n,), pred (n,))``, or None if nothing is above ``limit``.
+
+    ``strained`` marks the inner vertices next to a triangle above the limit
+    and reachable from the outline; ``dist`` and ``pred`` are the shortest
+    paths along mesh edges (3D lengths) from the outline.
+    """
+    import scipy.sparse as sp
+    from scipy.sparse import csgraph
+
+    from ..measure import triangle_strains
+
+    v, f = result.vertices, result.faces
+    above = np.flatnonzero(triangle_strains(v, f, result.uv).magnitude > limit)
+    if not len(above):
+        return None
+    n = len(v)
+    edges = unique_edges(f)
+    weight = np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)
+    graph = sp.coo_matrix((np.r_[weight, weight], (np.r_[edges[:, 0], edges[:, 1]],
+                                                    np.r_[edges[:, 1], edges[:, 0]])), shape=(n, n)).tocsr()
+    boundary = unique_ints(np.concatenate(result.loops))
+    dist, pred, _ = csgraph.dijkstra(graph, indices=boundary, min_only=True, return_predecessors=True)
+    strained = np.zeros(n, dtype=bool)
+    strained[f[above].ravel()] = True
+    strained[boundary] = False
+    return strained & np.isfinite(dist), dist, pred
 
 
 def _grain_table(grain, model) -> dict:

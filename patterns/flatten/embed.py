@@ -15,6 +15,7 @@ as the 3D boundary; LSCM: two boundary vertices pinned at their 3D distance).
 from __future__ import annotations
 
 import numpy as np
+import qdldl
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -107,8 +108,6 @@ class LDL:
 
     def factorize(self, values: np.ndarray) -> LDLFactor:
         """Factorise the matrix with these upper-triangle ``values`` ``(k,) float64``."""
-        import qdldl
-
         upper = sp.csc_matrix((np.asarray(values, dtype=np.float64)[self._slot], self._indices, self._indptr),
                               shape=(self._n, self._n))
         if self._solver is None:

@@ -559,20 +559,24 @@ class _StiffLaplacian:
 
     def factorize(self, weight: np.ndarray) -> LDLFactor:
         """Factorise with edge weights ``weight`` ``(k,) float64``."""
-        e0, e1 = self._edges[:, 0], self._edges[:, 1]
-        diagonal = np.bincount(e0, weight, self._n) + np.bincount(e1, weight, self._n)
-        diagonal[0] += self._anchor
+        diagonal = _degrees(self._n, self._edges, weight, anchor=self._anchor)
         return self._ldl.factorize(np.r_[-weight[self._inner], diagonal[self._free]])
 
 
 def _laplacian(n: int, edges: np.ndarray, weight: np.ndarray, *, anchor: float = 0.0) -> sp.csc_matrix:
     """The graph Laplacian ``D - W`` with edge weights ``weight`` (plus ``anchor`` at vertex 0), ``(n, n)`` CSC."""
     e0, e1 = edges[:, 0], edges[:, 1]
-    diagonal = np.bincount(e0, weight, n) + np.bincount(e1, weight, n)
-    diagonal[0] += anchor
+    diagonal = _degrees(n, edges, weight, anchor=anchor)
     node = np.arange(n)
     return sp.csc_matrix((np.r_[-weight, -weight, diagonal], (np.r_[e0, e1, node], np.r_[e1, e0, node])),
                          shape=(n, n))
+
+
+def _degrees(n: int, edges: np.ndarray, weight: np.ndarray, *, anchor: float = 0.0) -> np.ndarray:
+    """The Laplacian's diagonal ``(n,)``: each vertex's summed edge weight, plus ``anchor`` at vertex 0."""
+    diagonal = np.bincount(edges[:, 0], weight, n) + np.bincount(edges[:, 1], weight, n)
+    diagonal[0] += anchor
+    return diagonal
 
 
 def _size(uv: np.ndarray) -> float:
