@@ -9,7 +9,7 @@ The public API, all importable from the top level::
 
     result = patterns.flatten_mesh(vertices, faces)   # (n, 3), (m, 3) arrays in
     result.uv                                         # (n, 2) flat positions, 1:1
-    result.overlap.one_to_one, result.distortion.edge_strain_rms
+    result.overlap.one_to_one, result.distortion.strain_rms
 """
 
 from .check import Finding, Overlap, Report, check, overlap_verdict
@@ -25,9 +25,11 @@ from .errors import (
 )
 from .export import heat_map, preview_dxf
 from .flatten import METHODS, Flattening, flatten, flatten_mesh
+from .flatten.energy import ENERGIES
+from .flatten.seams import Ease, SeamLengths
 from .layout import Layout, layout
 from .load import load, read_cad, read_mesh
-from .measure import Distortion, distortion
+from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
 from .model import Model, Panel, Seam
 from .pattern import FlatPanel, FlatSeam, Pattern
@@ -36,11 +38,13 @@ from .tessellate import mesh_shape, tessellate_face
 __version__ = "0.1.0"
 
 __all__ = [
+    "ENERGIES",
     "METHODS",
     "CadError",
     "Connectivity",
     "Cut",
     "Distortion",
+    "Ease",
     "ExportError",
     "Finding",
     "FlatPanel",
@@ -58,6 +62,8 @@ __all__ = [
     "PatternsError",
     "Report",
     "Seam",
+    "SeamLengths",
+    "StrainStats",
     "__version__",
     "check",
     "cut_to_disk",

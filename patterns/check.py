@@ -137,6 +137,7 @@ class Code(str, Enum):
     PANELS_OVERLAP = "panels-overlap"
     STRAIN_ABOVE_LIMIT = "strain-above-limit"
     SEAM_MISMATCH_ABOVE_LIMIT = "seam-mismatch-above-limit"
+    SEAM_LENGTH_NOT_KEPT = "seam-length-not-kept"
     NOT_CONVERGED = "not-converged"
     DARTS = "darts"
 
@@ -185,10 +186,13 @@ class Finding:
 
 @dataclass(frozen=True)
 class PanelReport:
-    """Numbers of one panel (strains dimensionless: 0.01 = 1 %; areas mm^2).
+    """Numbers of one panel (strains dimensionless: 0.01 = 1 %; areas mm^2; places mm).
 
-    The triangle strain is the larger-magnitude principal strain of each
-    triangle; its statistics are weighted by 3D triangle area.
+    The strains are the principal strains of the map from the surface to the
+    plane, weighted by 3D triangle area (:class:`patterns.measure.StrainStats`):
+    the material's strain, which converges as the mesh is refined.  The edge
+    strain columns count edges, so they change with the triangulation; they
+    are kept for comparison only.  An exact development has no strain.
     """
 
     name: str
@@ -196,8 +200,15 @@ class PanelReport:
     area_3d: float
     area_flat: float
     strain_rms: float
-    strain_max: float
+    """RMS of both principal strains of every triangle."""
     strain_p95: float
+    """95th percentile of each triangle's largest principal strain magnitude."""
+    strain_p99: float
+    strain_max: float
+    strain_max_at: tuple
+    """``(x, y)`` of the most strained triangle's centre in the flat pattern as placed, mm."""
+    stretch_min: float
+    """The smallest principal stretch of any triangle (1 = its 3D size, near 0 = pressed flat)."""
     share_above_limit: float | None
     """Share of the 3D area whose triangle strain exceeds ``max_strain`` (None without a limit)."""
     edge_strain_rms: float
@@ -206,6 +217,8 @@ class PanelReport:
     one_to_one: bool
     iterations: int
     converged: bool
+    energy: str = ""
+    """The energy the relaxation minimised (``"arap"``, ``"hybrid"``, ...); "" for a grower or an exact development."""
     darts: int = 0
     """Darts cut by ``flatten(..., max_strain=...)``."""
 
@@ -225,13 +238,16 @@ class SeamReport:
     ``length_3d`` on a curve by the chords' sag): compare flat lengths with this."""
     length_flat: tuple
     """Flat length on side 0 and on side 1."""
+    length_held: tuple | None
+    """The flat length each side was held at (``flatten(seams="true")``: its 3D polyline
+    length times its ease); None for a free seam."""
     mismatch: float
     """``length_flat[0] - length_flat[1]``, mm."""
     mismatch_percent: float
     """``mismatch / length_3d * 100``."""
 
 
-REPORT_SCHEMA = "patterns.report/1"
+REPORT_SCHEMA = "patterns.report/2"
 """The ``schema`` value of :meth:`Report.to_dict` (see docs/report.md)."""
 
 
@@ -277,8 +293,9 @@ class Report:
             "ok": self.ok,
             "units": {"length": "mm", "area": "mm2", "strain": "ratio (0.01 = 1 %)"},
             "limits": {"max_strain": self.max_strain, "max_seam_mismatch": self.max_seam_mismatch},
-            "panels": [asdict(p) for p in self.panels],
-            "seams": [{**asdict(s), "panels": list(s.panels), "length_flat": list(s.length_flat)}
+            "panels": [{**asdict(p), "strain_max_at": list(p.strain_max_at)} for p in self.panels],
+            "seams": [{**asdict(s), "panels": list(s.panels), "length_flat": list(s.length_flat),
+                       "length_held": None if s.length_held is None else list(s.length_held)}
                       for s in self.seams],
             "findings": [f.to_dict() for f in self.findings],
         }
@@ -324,9 +341,16 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
     ------
     InputError
         Not a pattern, or a limit that is not a positive number.
+
+    Notes
+    -----
+    A seam held at its length (``flatten(seams="true")``) whose flat length on
+    a side is off by more than :data:`SEAM_LENGTH_TOLERANCE` is a
+    ``seam-length-not-kept`` finding: the relaxation could not keep it without
+    folding.
     """
     from .errors import InputError
-    from .measure import edge_strain, strain_summary, triangle_strains
+    from .measure import edge_strain, strain_stats
     from .pattern import Pattern
 
     if not isinstance(pattern, Pattern):
@@ -338,65 +362,98 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
     findings = []
     panel_reports = []
     for flat in pattern.panels:
-        uv, faces, vertices = flat.uv, flat.faces, flat.vertices
-        ts = triangle_strains(vertices, faces, uv)
-        mag, w = ts.magnitude, ts.area_3d
-        es = edge_strain(vertices, faces, uv)
-        if flat.flattening.method == "exact":
-            # An exact development is an isometry of the surface: no strain.  What the
-            # triangles would show is a straight 3D chord against the flat distance
-            # between two exact points, (h / R)**2 / 24 -- the mesh, not the material.
-            mag, es = np.zeros_like(mag), np.zeros_like(es)
-        share = None
-        if max_strain is not None:
-            above = np.flatnonzero(mag > max_strain)
-            share = float(w[above].sum() / w.sum())
-            if len(above):
-                worst = above[np.argmax(mag[above])]
-                centre = uv[faces[worst]].mean(axis=0)
-                findings.append(Finding(
-                    Code.STRAIN_ABOVE_LIMIT, Severity.LIMIT, (flat.name,), centre[None, :], _readonly(above), None,
-                    f"panel {flat.name}: strain above {max_strain:.2%} on {share:.1%} of its area "
-                    f"({len(above)} triangles), up to {mag[worst]:.2%} at ({centre[0]:.1f}, {centre[1]:.1f}) mm"))
-        findings += _panel_overlaps(flat)
-        res = flat.flattening
-        if flat.darts:
-            tips = np.array([uv[d[-1]] for d in flat.darts])
-            length = sum(float(np.linalg.norm(np.diff(vertices[d], axis=0), axis=1).sum()) for d in flat.darts)
-            findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), _readonly(tips), np.zeros(0, dtype=np.int64),
-                                    None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
-                                          f"the limit ({length:.1f} mm of cuts; points: their tips)"))
-        if not res.converged:
-            findings.append(Finding(Code.NOT_CONVERGED, Severity.NOTE, (flat.name,), np.zeros((0, 2)),
-                                    np.zeros(0, dtype=np.int64), None,
-                                    f"panel {flat.name}: the relaxation stopped after {res.iterations} iterations "
-                                    f"before converging"))
-        rms, biggest, p95 = strain_summary(ts) if flat.flattening.method != "exact" else (0.0, 0.0, 0.0)
-        panel_reports.append(PanelReport(
-            name=flat.name, n_triangles=len(faces), area_3d=float(w.sum()), area_flat=flat.area,
-            strain_rms=rms, strain_max=biggest, strain_p95=p95, share_above_limit=share,
-            edge_strain_rms=float(np.sqrt(np.mean(es**2))), edge_strain_max=float(es.max()),
-            n_folded=int(np.count_nonzero(ts.area_change <= -1.0)), one_to_one=bool(res.one_to_one),
-            iterations=int(res.iterations), converged=bool(res.converged), darts=len(flat.darts)))
+        report, found = _panel_report(flat, max_strain, edge_strain, strain_stats)
+        panel_reports.append(report)
+        findings += found
     findings += _overlaps_between(pattern)
     seam_reports = []
     for fs in pattern.seams:
-        seam = fs.seam
-        names = tuple(pattern.panels[p].name for p in seam.panels)
-        pct = 100.0 * fs.mismatch / seam.length if seam.length > 0 else 0.0
-        seam_reports.append(SeamReport(seam.id, names, seam.cad_edge, float(seam.length), seam.polyline_length,
-                                       tuple(float(x) for x in fs.flat_lengths), fs.mismatch, pct))
-        if max_seam_mismatch is not None and abs(fs.mismatch) > max_seam_mismatch:
-            mid = pattern.panels[seam.panels[0]].uv[seam.vertices[0][len(seam.vertices[0]) // 2]]
-            findings.append(Finding(
-                Code.SEAM_MISMATCH_ABOVE_LIMIT, Severity.LIMIT, names, mid[None, :], np.zeros(0, dtype=np.int64),
-                seam.id, f"seam {seam.id} ({names[0]} / {names[1]}): flat lengths {fs.flat_lengths[0]:.2f} and "
-                         f"{fs.flat_lengths[1]:.2f} mm differ by {abs(fs.mismatch):.2f} mm "
-                         f"(limit {max_seam_mismatch:g} mm)"))
+        report, found = _seam_report(pattern, fs, max_seam_mismatch)
+        seam_reports.append(report)
+        findings += found
     order = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
     findings.sort(key=lambda f: order[f.severity])
     return Report(pattern.name, tuple(panel_reports), tuple(seam_reports), tuple(findings), max_strain,
                   max_seam_mismatch)
+
+
+SEAM_LENGTH_TOLERANCE = 1e-3
+"""A held seam side whose flat length is off its held length by more than this fraction is reported."""
+
+
+def _panel_report(flat, max_strain, edge_strain, strain_stats):
+    """``(PanelReport, findings)`` of one flat panel."""
+    uv, faces, vertices = flat.uv, flat.faces, flat.vertices
+    ts = flat.strains
+    mag, w = ts.magnitude, ts.area_3d
+    stats = strain_stats(ts)
+    exact = flat.flattening.method == "exact"
+    es = np.zeros(len(faces)) if exact else edge_strain(vertices, faces, uv)  # exact: no strain at all
+    findings = []
+    share = None
+    if max_strain is not None:
+        above = np.flatnonzero(mag > max_strain)
+        share = float(w[above].sum() / w.sum())
+        if len(above):
+            worst = above[np.argmax(mag[above])]
+            centre = uv[faces[worst]].mean(axis=0)
+            findings.append(Finding(
+                Code.STRAIN_ABOVE_LIMIT, Severity.LIMIT, (flat.name,), centre[None, :], _readonly(above), None,
+                f"panel {flat.name}: strain above {max_strain:.2%} on {share:.1%} of its area "
+                f"({len(above)} triangles), up to {mag[worst]:.2%} at ({centre[0]:.1f}, {centre[1]:.1f}) mm"))
+    findings += _panel_overlaps(flat)
+    res = flat.flattening
+    none = np.zeros(0, dtype=np.int64)
+    if flat.darts:
+        tips = np.array([uv[d[-1]] for d in flat.darts])
+        length = sum(float(np.linalg.norm(np.diff(vertices[d], axis=0), axis=1).sum()) for d in flat.darts)
+        findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), _readonly(tips), none,
+                                None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
+                                      f"the limit ({length:.1f} mm of cuts; points: their tips)"))
+    if not res.converged:
+        findings.append(Finding(Code.NOT_CONVERGED, Severity.NOTE, (flat.name,), np.zeros((0, 2)), none, None,
+                                f"panel {flat.name}: the relaxation stopped after {res.iterations} iterations "
+                                f"before converging"))
+    at = uv[faces[stats.worst]].mean(axis=0)
+    report = PanelReport(
+        name=flat.name, n_triangles=len(faces), area_3d=float(w.sum()), area_flat=flat.area,
+        strain_rms=stats.rms, strain_p95=stats.p95, strain_p99=stats.p99, strain_max=stats.max,
+        strain_max_at=(float(at[0]), float(at[1])), stretch_min=float(ts.stretch[:, 1].min()),
+        share_above_limit=share,
+        edge_strain_rms=float(np.sqrt(np.mean(es**2))), edge_strain_max=float(es.max()),
+        n_folded=int(np.count_nonzero(ts.area_change <= -1.0)), one_to_one=bool(res.one_to_one),
+        iterations=int(res.iterations), converged=bool(res.converged), energy=res.energy, darts=len(flat.darts))
+    return report, findings
+
+
+def _seam_report(pattern, fs, max_seam_mismatch):
+    """``(SeamReport, findings)`` of one flat seam."""
+    seam = fs.seam
+    names = tuple(pattern.panels[p].name for p in seam.panels)
+    none = np.zeros(0, dtype=np.int64)
+    pct = 100.0 * fs.mismatch / seam.length if seam.length > 0 else 0.0
+    held = None if fs.held_lengths is None else tuple(float(x) for x in fs.held_lengths)
+    report = SeamReport(seam.id, names, seam.cad_edge, float(seam.length), seam.polyline_length,
+                        tuple(float(x) for x in fs.flat_lengths), held, fs.mismatch, pct)
+    findings = []
+    mid = pattern.panels[seam.panels[0]].uv[seam.vertices[0][len(seam.vertices[0]) // 2]]
+    if max_seam_mismatch is not None and abs(fs.mismatch) > max_seam_mismatch:
+        findings.append(Finding(
+            Code.SEAM_MISMATCH_ABOVE_LIMIT, Severity.LIMIT, names, mid[None, :], none,
+            seam.id, f"seam {seam.id} ({names[0]} / {names[1]}): flat lengths {fs.flat_lengths[0]:.2f} and "
+                     f"{fs.flat_lengths[1]:.2f} mm differ by {abs(fs.mismatch):.2f} mm "
+                     f"(limit {max_seam_mismatch:g} mm)"))
+    if held is not None:
+        off = [(side, fs.flat_lengths[side], held[side]) for side in range(2)
+               if abs(fs.flat_lengths[side] / held[side] - 1.0) > SEAM_LENGTH_TOLERANCE]
+        if off:
+            side, got, want = max(off, key=lambda x: abs(x[1] / x[2] - 1.0))
+            findings.append(Finding(
+                Code.SEAM_LENGTH_NOT_KEPT, Severity.LIMIT, names, mid[None, :], none, seam.id,
+                f"seam {seam.id} ({names[0]} / {names[1]}): could not be held at its length "
+                f"(folds in the way, or the relaxation stopped early): "
+                f"{got:.2f} mm flat on {names[side]}'s side, {want:.2f} mm wanted ({100 * (got / want - 1):+.2f} %)"))
+    return report, findings
 
 
 def crossing_segments(uv: np.ndarray, loops):

@@ -73,9 +73,24 @@ def _direction(text: str):
     return tuple(values)
 
 
+def _ease(text: str):
+    """``SEAM:PANEL:AMOUNT`` (mm, or a percentage with %) as a :class:`patterns.Ease`."""
+    from .flatten.seams import Ease
+
+    try:
+        seam, panel, amount = text.split(":")
+        if amount.endswith("%"):
+            return Ease(int(seam), panel, ratio=float(amount[:-1]) / 100.0)
+        return Ease(int(seam), panel, mm=float(amount))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected SEAM:PANEL:MM or SEAM:PANEL:PERCENT%, got {text!r}") from None
+
+
 def _parser() -> argparse.ArgumentParser:
     from . import METHODS, __version__
     from .export.dxf import MACHINE_VERSIONS, PROFILES, UNITS
+    from .flatten.energy import ENERGIES
+    from .flatten.seams import SeamLengths
 
     parser = argparse.ArgumentParser(
         prog="patterns", description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns."
@@ -95,9 +110,17 @@ def _parser() -> argparse.ArgumentParser:
     def flattening(p):
         p.add_argument("--method", choices=METHODS, default="relaxed", help="flattening method (default relaxed)")
         p.add_argument("--max-iterations", type=int, default=500, help="relaxation iterations at most (default 500)")
+        p.add_argument("--energy", choices=ENERGIES, default="auto",
+                       help="relaxed: the distortion minimised (default auto: ARAP, the squared principal strains, "
+                            "or the hybrid where ARAP would press triangles flat)")
+        p.add_argument("--seams", choices=tuple(m.value for m in SeamLengths), default="true",
+                       help="relaxed: hold every seam edge at its 3D length (true, default), each seam's total "
+                            "length only (total), or nothing (free)")
+        p.add_argument("--ease", type=_ease, action="append", default=None, metavar="SEAM:PANEL:AMOUNT",
+                       help="deliberate extra length on one side of a seam: mm, or %% of its length (repeatable)")
         p.add_argument("--min-stretch", type=float, default=None, metavar="R",
                        help="relaxed: keep every triangle at least this fraction of its size in every direction, "
-                            "0..1 (0.3 stops a dome's pole being pressed flat)")
+                            "0..1")
         p.add_argument("--thickness", type=float, default=0.0, help="sheet thickness, mm: develop the neutral surface")
         p.add_argument("--k-factor", type=float, default=0.5, help="neutral surface from the inside, 0..1 (default 0.5)")
         p.add_argument("--reference", choices=("inside", "outside", "mid"), default="mid",
@@ -187,8 +210,8 @@ def _flatten(model, args):
     progress = Progress(f"flattening {len(model.panels)} panels")
     try:
         return flatten(model, method=args.method, max_iterations=args.max_iterations, thickness=args.thickness,
-                       k_factor=args.k_factor, reference=args.reference, grain=args.grain,
-                       min_stretch=args.min_stretch, progress=progress)
+                       k_factor=args.k_factor, reference=args.reference, grain=args.grain, energy=args.energy,
+                       seams=args.seams, ease=args.ease, min_stretch=args.min_stretch, progress=progress)
     finally:
         progress.close()
 
@@ -365,7 +388,8 @@ def _batch_one(path: str, out: str, options: dict) -> dict:
         model = _load(args)
         pattern = flatten(model, method=options["method"], max_iterations=options["max_iterations"],
                           thickness=options["thickness"], k_factor=options["k_factor"], reference=options["reference"],
-                          grain=options["grain"], min_stretch=options["min_stretch"])
+                          grain=options["grain"], min_stretch=options["min_stretch"], energy=options["energy"],
+                          seams=options["seams"], ease=options["ease"])
         if options["roll_width"] is not None:
             pattern = pattern.layout(width=options["roll_width"], margin=options["seam_allowance"]).pattern
         report = check(pattern, max_strain=options["max_strain"], max_seam_mismatch=options["max_seam_mismatch"])
@@ -405,7 +429,8 @@ def _cmd_batch(args) -> int:
     options = {k: getattr(args, k) for k in ("max_edge", "tolerance", "method", "max_iterations", "max_strain",
                                               "max_seam_mismatch", "profile", "seam_allowance", "dxf_version",
                                               "thickness", "k_factor", "reference", "arcs", "bend_spacing",
-                                              "grain", "notch_spacing", "roll_width", "min_stretch")}
+                                              "grain", "notch_spacing", "roll_width", "min_stretch", "energy",
+                                              "seams", "ease")}
     progress = Progress(f"batch of {len(files)} files")
     rows = []
     if args.scheduler:

@@ -8,8 +8,11 @@ plane (the 3D <-> 2D map is the vertex index).  Millimetres throughout.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
+
+from .measure import TriangleStrain, no_strain, triangle_strains
 
 __all__ = ["FlatPanel", "FlatSeam", "Pattern"]
 
@@ -187,6 +190,14 @@ class FlatPanel:
         """(k, 2) float64, mm: flat points of one outline loop (not repeated at the end)."""
         return self.uv[self.loops[loop]]
 
+    @cached_property
+    def strains(self) -> TriangleStrain:
+        """The principal strains of every triangle, as :func:`patterns.check`, the heat map and the DXF
+        labels report them: zero for an exact development (:func:`patterns.measure.no_strain`)."""
+        if self.flattening.method == "exact":
+            return no_strain(self.vertices, self.faces)
+        return triangle_strains(self.vertices, self.faces, self.flattening.uv)
+
     @property
     def area(self) -> float:
         """Flat area, mm^2."""
@@ -206,10 +217,14 @@ class FlatSeam:
     flat_lengths : (float, float)
         Length of the seam's polyline in the flat pattern on side 0 and side 1,
         mm.  The difference is what puckers when the pieces are sewn or welded.
+    held_lengths : (float, float) or None
+        The flat length each side was held at (``flatten(seams="true")``): the
+        3D length of its polyline times its ease, mm; None for a free seam.
     """
 
     seam: object
     flat_lengths: tuple
+    held_lengths: tuple | None = None
 
     @property
     def length(self) -> float:

@@ -674,13 +674,26 @@ class _ShapeMesher:
         for k, m in enumerate(meshes):
             for (e, _), slots in zip(m.occurrences, m.occ_slots):
                 occ_of_edge[e].append((k, offsets[k] + slots))
-        # Merge face-vertices along edges shared by two faces of one panel.
+        # Merge face-vertices along edges shared by two faces of one panel, and
+        # along the seam line of a freeform face with itself (OpenCascade's seam
+        # of a sphere or a surface of revolution, from the rim to the pole): that
+        # line is the parametrisation's, not the part's, and cutting along it
+        # would slit a cap to its pole.  A face that closes into a tube is cut
+        # open again below, along a path of its own choosing.  Developable faces
+        # keep their seam line: their exact development unrolls them from it.
+        freeform = [surface_of(self.surfaces[k], self.faces[k], self.devs[k]) is None for k in range(len(meshes))]
         rows, cols = [], []
+        self_merged = set()
         for e, occ in enumerate(occ_of_edge):
             for (ka, va), (kb, vb) in zip(occ[:-1], occ[1:]):
-                if ka != kb and panel_of_face[ka] == panel_of_face[kb] and len(va) == len(vb):
-                    rows.append(va)
-                    cols.append(vb)
+                if panel_of_face[ka] != panel_of_face[kb] or len(va) != len(vb):
+                    continue
+                if ka == kb and not freeform[ka]:
+                    continue
+                if ka == kb:
+                    self_merged.add(e)
+                rows.append(va)
+                cols.append(vb)
         if rows:
             rows, cols = np.concatenate(rows), np.concatenate(cols)
         else:
@@ -700,8 +713,9 @@ class _ShapeMesher:
             vertices = coords[fv[first[order]]]
             faces = local[tri]
             pname = f"{self.name}: panel {label}"
-            if len(members) > 1:
-                # A group may close up into a tube or a box: cut it open.
+            if len(members) > 1 or any(e in self_merged for e, _ in meshes[members[0]].occurrences):
+                # A group, or a freeform face sewn along its own seam line, may
+                # close up into a tube or a box: cut it open.
                 cut = cut_to_disk(vertices, faces, name=pname)
                 vertices, faces = cut.vertices, cut.faces
                 cuts.extend((p, path_sides) for path_sides in zip(cut.paths, cut.sides))
@@ -723,7 +737,7 @@ class _ShapeMesher:
             ka, va = occ[0]
             for kb, vb in occ[1:]:
                 pa, pb = int(panel_of_face[ka]), int(panel_of_face[kb])
-                if ka != kb and pa == pb:
+                if (ka != kb or e in self_merged) and pa == pb:
                     continue  # inside one panel
                 params, gids, length = self.edge_data[e]
                 seams.append(Seam(id=len(seams), panels=(pa, pb), points=points[gids],

@@ -24,8 +24,8 @@ def cup():
     return patterns.flatten(patterns.load(SAMPLES / "cup.step"))
 
 
-def independent_triangle_strain(vertices, faces, uv):
-    """Dominant principal strain per triangle by an SVD of the 3D -> 2D Jacobian
+def independent_principal_strains(vertices, faces, uv):
+    """Both principal strains per triangle ``(m, 2)`` by an SVD of the 3D -> 2D Jacobian
     (orthonormal frame from the first edge and the normal), and the 3D areas."""
     p, q = vertices[faces], uv[faces]
     e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
@@ -38,7 +38,12 @@ def independent_triangle_strain(vertices, faces, uv):
     flat = np.stack([q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]], -1)  # (m, 2, 2) columns
     jac = flat @ np.linalg.inv(ref)
     s = np.linalg.svd(jac, compute_uv=False)  # (m, 2) descending
-    strain = s - 1
+    return s - 1, area
+
+
+def independent_triangle_strain(vertices, faces, uv):
+    """The dominant (larger-magnitude) principal strain per triangle, and the 3D areas."""
+    strain, area = independent_principal_strains(vertices, faces, uv)
     dominant = np.where(np.abs(strain[:, 0]) >= np.abs(strain[:, 1]), strain[:, 0], strain[:, 1])
     return dominant, area
 
@@ -59,17 +64,21 @@ def test_developable_sample_has_no_strain_and_no_mismatch(hopper):
 def test_doubly_curved_strain_statistics_equal_an_independent_computation(cup):
     report = patterns.check(cup, max_strain=0.03)
     for flat, numbers in zip(cup.panels, report.panels):
-        dominant, area = independent_triangle_strain(flat.vertices, flat.faces, flat.uv)
-        mag = np.abs(dominant)
+        strain, area = independent_principal_strains(flat.vertices, flat.faces, flat.uv)
+        mag = np.abs(strain).max(axis=1)
         assert numbers.strain_max == pytest.approx(mag.max(), rel=1e-9)
-        assert numbers.strain_rms == pytest.approx(np.sqrt(np.sum(area * mag**2) / area.sum()), rel=1e-9)
+        worst = np.argmax(mag)
+        np.testing.assert_allclose(numbers.strain_max_at, flat.uv[flat.faces[worst]].mean(axis=0), atol=1e-9)
+        # RMS of both principal strains, weighted by 3D area.
+        assert numbers.strain_rms == pytest.approx(np.sqrt(np.sum(area[:, None] * strain**2) / (2 * area.sum())),
+                                                   rel=1e-9)
         order = np.argsort(mag)
         cum = np.cumsum(area[order]) / area.sum()
         assert numbers.strain_p95 == pytest.approx(mag[order][np.searchsorted(cum, 0.95)], rel=1e-9)
+        assert numbers.strain_p99 == pytest.approx(mag[order][np.searchsorted(cum, 0.99)], rel=1e-9)
         assert numbers.share_above_limit == pytest.approx(area[mag > 0.03].sum() / area.sum(), rel=1e-9)
         assert numbers.area_3d == pytest.approx(area.sum(), rel=1e-12)
-        # Measured on the quarter-sphere panels: RMS 3.2 %, max 8.3 %, 35 % of the area above 3 %.
-        assert 0.015 < numbers.strain_rms < 0.035 and 0.1 < numbers.share_above_limit < 0.4
+        assert numbers.share_above_limit > 0.05  # a quarter sphere cannot be laid flat within 3 %
     # The strain limit is a finding with the worst place named, and the report is not ok.
     limits = [f for f in report.findings if f.code is Code.STRAIN_ABOVE_LIMIT]
     assert len(limits) == 4 and not report.ok
@@ -166,12 +175,28 @@ def test_crossing_outline_is_caught_at_the_crossing():
 
 
 def test_seam_mismatch_limit(cup):
-    report = patterns.check(cup, max_seam_mismatch=0.05)
+    free = patterns.flatten(cup.model, seams="free")
+    report = patterns.check(free, max_seam_mismatch=0.001)
     worst = max(abs(s.mismatch) for s in report.seams)
     found = [f for f in report.findings if f.code is Code.SEAM_MISMATCH_ABOVE_LIMIT]
-    assert len(found) == sum(abs(s.mismatch) > 0.05 for s in report.seams) >= 1
-    assert worst > 0.05
-    assert patterns.check(cup, max_seam_mismatch=10.0).ok
+    assert len(found) == sum(abs(s.mismatch) > 0.001 for s in report.seams) >= 1
+    assert worst > 0.001
+    assert patterns.check(free, max_seam_mismatch=10.0).ok
+
+
+def test_seams_held_at_their_length_and_a_seam_that_was_not(cup):
+    """Seam-true flattening (the default): each side as long as the 3D polyline it
+    is laid along, so both sides equal; a relaxation stopped early is reported."""
+    report = patterns.check(cup, max_seam_mismatch=0.01)
+    assert report.ok
+    for s in report.seams:
+        assert s.length_held == pytest.approx((s.length_3d_polyline, s.length_3d_polyline), rel=1e-12)
+        for flat in s.length_flat:
+            assert flat == pytest.approx(s.length_3d_polyline, rel=2e-4)
+    short = patterns.flatten(cup.model, max_iterations=2)
+    findings = [f for f in patterns.check(short).findings if f.code is Code.SEAM_LENGTH_NOT_KEPT]
+    assert findings and all(f.severity is Severity.LIMIT and f.seam is not None for f in findings)
+    assert "could not be held" in findings[0].message
 
 
 def test_json_report_round_trips_with_its_schema(cup, tmp_path):
@@ -179,13 +204,14 @@ def test_json_report_round_trips_with_its_schema(cup, tmp_path):
     path = tmp_path / "cup.json"
     report.to_json(path)
     doc = json.loads(path.read_text())
-    assert doc["schema"] == "patterns.report/1" and doc["ok"] is False and doc["pattern"] == "cup.step"
+    assert doc["schema"] == "patterns.report/2" and doc["ok"] is False and doc["pattern"] == "cup.step"
     assert doc["limits"] == {"max_strain": 0.03, "max_seam_mismatch": None}
     assert [p["name"] for p in doc["panels"]] == ["face0", "face1", "face2", "face3"]
     for p, numbers in zip(doc["panels"], report.panels):
         assert p["strain_rms"] == numbers.strain_rms and p["area_3d"] == numbers.area_3d
     for s, numbers in zip(doc["seams"], report.seams):
         assert s["length_flat"] == list(numbers.length_flat) and s["mismatch"] == numbers.mismatch
+        assert s["length_held"] == list(numbers.length_held)
     assert {f["code"] for f in doc["findings"]} == {"strain-above-limit"}
     assert all(len(f["points"][0]) == 2 for f in doc["findings"])
     with pytest.raises(ExportError):

@@ -117,7 +117,7 @@ def test_demo_runs_the_whole_pipeline(tmp_path):
         assert str(out / name) in proc.stdout or f"patterns-demo/{name}" in proc.stdout
     doc, auditor = recover.readfile(out / "cup.dxf")
     assert not auditor.has_errors and len(doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')) == 4
-    assert json.loads((out / "cup.json").read_text())["schema"] == "patterns.report/1"
+    assert json.loads((out / "cup.json").read_text())["schema"] == "patterns.report/2"
 
 
 def _batch_folder(folder: Path, n_good: int = 20) -> list[str]:
@@ -304,22 +304,27 @@ def test_a_closed_pipe_does_not_stop_the_files_or_show_a_traceback(tmp_path):
     assert json.loads((tmp_path / "dish.json").read_text())["panels"][0]["one_to_one"]
 
 
-def test_min_stretch_keeps_a_dome_from_being_pressed_flat(tmp_path):
-    import trimesh
+def test_energy_and_min_stretch_options(tmp_path):
+    """--energy arap presses part of a head flat (its least-strain layout would fold);
+    --min-stretch 0.3 keeps every triangle open; the default (auto) goes on with the hybrid."""
+    from .conftest import CORPUS
 
-    from patterns import surfaces
-
-    v, f = surfaces.spherical_cap(radius=100.0, half_angle=90.0, n_faces=4000)
-    path = tmp_path / "dome.stl"
-    trimesh.Trimesh(v, f, process=False).export(path)
-    strain = {}
-    for label, extra in (("plain", ()), ("guarded", ("--min-stretch", "0.3"))):
+    path = CORPUS / "bff_bunnyhead.obj"
+    if not path.is_file():
+        pytest.skip(f"corpus mesh {path} is absent")
+    strain = {}  # the smallest principal stretch
+    for label, extra in (("arap", ("--energy", "arap")), ("guarded", ("--energy", "arap", "--min-stretch", "0.3")),
+                         ("auto", ())):
         report = tmp_path / f"{label}.json"
         proc = run("flatten", path, "-o", tmp_path / f"{label}.dxf", "--report", report, *extra)
         assert proc.returncode == 0, proc.stderr
-        strain[label] = json.loads(report.read_text())["panels"][0]["strain_max"]
-    assert strain["plain"] > 0.95  # a triangle at the pole pressed (nearly) flat
-    assert strain["guarded"] < 0.75  # none below about 0.3 of its size
+        panel = json.loads(report.read_text())["panels"][0]
+        strain[label] = panel["stretch_min"]
+        assert panel["energy"] == ("hybrid" if label == "auto" else "arap")
+    assert strain["arap"] < 1e-3  # a triangle pressed (nearly) flat
+    assert strain["guarded"] > 0.25 and strain["auto"] > 0.1  # none below about 0.3 (0.1) of its size
     proc = run("flatten", path, "-o", tmp_path / "bad.dxf", "--min-stretch", "1.5")
     assert proc.returncode == 2 and "min_stretch" in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "bad.dxf").exists()
+
+

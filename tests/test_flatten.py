@@ -202,7 +202,12 @@ def test_rigid_motion_of_the_input_moves_the_output_rigidly(seed, scale, method)
     a = patterns.flatten_mesh(v, f, method=method, seed_face=17).uv
     b = patterns.flatten_mesh(moved, f, method=method, seed_face=17).uv
     size = np.ptp(a, axis=0).max()
-    assert rigid_fit_residual(a, b) < 1e-9 * size * max(1.0, scale / 100)
+    # The growers are exact constructions: rigid to round-off.  The relaxation
+    # runs in a numbering sorted along a space-filling curve, which a rotation
+    # changes: its path rounds differently and it stops within its tolerance
+    # (measured 1e-6 of the size).
+    allowed = 1e-9 if method != "relaxed" else 2e-5
+    assert rigid_fit_residual(a, b) < allowed * size * max(1.0, scale / 100)
 
 
 @pytest.mark.parametrize("method", ["isometric", "relaxed"])

@@ -30,13 +30,12 @@ def test_generated_parts_come_out_one_to_one_and_closer_to_true_lengths(shape):
     r = patterns.flatten_mesh(v, f)
     assert r.method == "relaxed" and r.n_folded == 0 and r.one_to_one
     assert independent_one_to_one(r.faces, r.uv)
-    assert r.distortion.edge_strain_rms <= greedy.distortion.edge_strain_rms
+    assert r.distortion.strain_rms <= greedy.distortion.strain_rms
     if greedy.one_to_one:
         assert r.start == "greedy"
-        # Measured: 0.58-0.62 of the greedy RMS on these parts.
-        assert r.distortion.edge_strain_rms < 0.8 * greedy.distortion.edge_strain_rms
-    # True scale: no rescaling, the flat area stays within the part's own strain.
-    assert abs(r.distortion.area_ratio - 1) < 3 * r.distortion.edge_strain_rms + 1e-3
+        # Measured: 0.59-0.68 of the greedy layout's principal-strain RMS on these parts
+        # (the greedy layout places every triangle at true size, so a rescale would show).
+        assert r.distortion.strain_rms < 0.8 * greedy.distortion.strain_rms
 
 
 def test_flip_free_steps_are_exact():
@@ -142,7 +141,7 @@ def test_iterations_and_progress():
     assert r.iterations == 3 and calls == [(1, 3), (2, 3), (3, 3)]
     assert not r.converged
     longer = patterns.flatten_mesh(v, f, max_iterations=200, tolerance=1e-6)
-    assert longer.distortion.edge_strain_rms <= r.distortion.edge_strain_rms
+    assert longer.distortion.strain_rms <= r.distortion.strain_rms
 
 
 def test_where_the_grower_overlaps_the_relaxation_starts_elsewhere_and_stays_one_to_one():
@@ -167,36 +166,12 @@ def _perturbed_cap(*, seed, scale):
     return v, f, conn, uv, rng
 
 
-def _assert_gradient_matches_finite_differences(energy, uv, rng):
-    """Central differences of ``energy(uv, mu)`` along a random direction, with and without the barrier."""
-    for mu in (0.0, 0.1):
-        _value, grad = energy(uv, mu)
-        direction = rng.normal(size=uv.shape)
-        h = 1e-6
-        numeric = (energy(uv + h * direction, mu)[0] - energy(uv - h * direction, mu)[0]) / (2 * h)
-        assert numeric == pytest.approx(float(np.sum(grad * direction)), rel=1e-6)
-
-
-def test_energy_gradient_matches_finite_differences():
-    from patterns.flatten.relax import _StressBarrier
-
-    v, f, conn, uv, rng = _perturbed_cap(seed=3, scale=0.05)  # off the optimum, still fold-free
-    energy = _StressBarrier(v, f, conn.edges, np.linalg.norm(v[conn.edges[:, 1]] - v[conn.edges[:, 0]], axis=1))
-    _assert_gradient_matches_finite_differences(energy, uv, rng)
-    # The barrier is |J^-1|^2 summed with weights: 2 per unit weight on a rigid
-    # layout, here a flat part laid down as it is.
-    p, f = surfaces.disk_mesh(300)
-    v, f, conn = validate_mesh(np.column_stack([p * 50.0, np.zeros(len(p))]), f)
-    flat = _StressBarrier(v, f, conn.edges, np.linalg.norm(v[conn.edges[:, 1]] - v[conn.edges[:, 0]], axis=1))
-    value, _ = flat(v[:, :2].copy(), 1.0)
-    assert value == pytest.approx(2 * flat.w.sum(), rel=1e-12)
-    assert flat.w.sum() == pytest.approx(0.75 * len(f), rel=1e-12)
-
-
 @pytest.mark.parametrize("name", ["bff_bunnyhead.obj", "bff_spothead.obj"])
 def test_heads_relax_far_below_their_conformal_start(name):
     """On heads the greedy grower folds; the relaxation starts from LSCM, whose
     ears are shrunk many times, and must open them up without folding."""
+    from patterns.measure import strain_rms, symmetric_dirichlet
+
     from .conftest import CORPUS
 
     path = CORPUS / name
@@ -206,14 +181,17 @@ def test_heads_relax_far_below_their_conformal_start(name):
     v, f, conn = validate_mesh(mesh.vertices, mesh.faces)
     start = lscm(v, f, conn)
     start = start * best_scale(v, conn.edges, start)
-    start_rms = patterns.distortion(v, f, start).edge_strain_rms
     r = patterns.flatten_mesh(v, f)
     assert r.start == "lscm" and r.one_to_one and r.n_folded == 0 and r.converged
     assert independent_one_to_one(r.faces, r.uv)
-    # Measured: 0.366 of 0.80 (bunny), 0.336 of 1.00 (spot); libigl SLIM gets
-    # 0.83 and 0.78, libigl ARAP 0.45 (264 folded) and 0.53 (no fold).
-    assert r.distortion.edge_strain_rms < 0.55 * start_rms
-    assert r.distortion.edge_strain_rms < 0.45
+    d = r.distortion
+    # LSCM's ears are crushed (1st-percentile stretch 0.0004 and 0.015, symmetric
+    # Dirichlet 3.6e5 and 371); the relaxation opens them: nothing below 0.1.
+    assert d.stretch_p1 > 0.1 and d.symmetric_dirichlet < 0.05 * symmetric_dirichlet(v, f, start)
+    assert d.strain_rms < strain_rms(v, f, start)
+    # The bunny's least-strain layout would fold (libigl ARAP folds 264 triangles):
+    # "auto" goes on with the hybrid energy there; spot's does not, so it stays ARAP.
+    assert r.energy == {"bff_bunnyhead.obj": "hybrid", "bff_spothead.obj": "arap"}[name]
 
 
 def test_ldl_refactorisations_solve_each_new_system_and_refuse_stale_factors():
@@ -299,19 +277,21 @@ def test_single_precision_factor_is_a_close_unit_free_preconditioner():
     """The relaxation's preconditioner is factorised in float32; its solves must
     stay close to the float64 ones and must not depend on the unit."""
     from patterns.flatten.embed import factorize
+    from patterns.flatten.numbering import dissection_order
     from patterns.flatten.relax import _laplacian
 
     v, f = surfaces.ellipsoid_cup(n_faces=10_000)
     v, f, conn = validate_mesh(v, f)
     e = conn.edges
+    order = dissection_order(v, e)  # the engine factorises in nested-dissection order
     rng = np.random.default_rng(11)
     b = rng.normal(size=(len(v), 2))
     solutions = []
     for unit in (1.0, 25.4):  # mm, then the same part in inches
         w = 1.0 / np.linalg.norm((v[e[:, 1]] - v[e[:, 0]]) / unit, axis=1) ** 2
         matrix = _laplacian(len(v), e, w, anchor=float(w.mean()))
-        exact = factorize(matrix).solve(b)
-        single = factorize(matrix, single=True).solve(b)
+        exact = factorize(matrix, order=order).solve(b)
+        single = factorize(matrix, single=True, order=order).solve(b)
         assert single.dtype == np.float64
         assert np.linalg.norm(single - exact) < 1e-3 * np.linalg.norm(exact)
         solutions.append(single * unit**2)  # L scales as unit**2, so L^-1 b as unit**-2
@@ -319,17 +299,20 @@ def test_single_precision_factor_is_a_close_unit_free_preconditioner():
 
 
 def test_min_stretch_guard_stops_crushed_triangles_and_changes_nothing_else():
-    from patterns.measure import principal_stretches
+    """ARAP alone presses part of a head flat (its fold-free minimum wants to fold there);
+    the guard keeps every triangle open, and is zero where nothing is squeezed."""
+    from .conftest import CORPUS
 
-    v, f = surfaces.spherical_cap(radius=100.0, half_angle=90.0, n_faces=10_000)
-    plain = patterns.flatten_mesh(v, f)
-    guarded = patterns.flatten_mesh(v, f, min_stretch=0.3)
-    s_plain = principal_stretches(plain.vertices, plain.faces, plain.uv).min(axis=1)
-    s_guard = principal_stretches(guarded.vertices, guarded.faces, guarded.uv).min(axis=1)
-    assert s_plain.min() < 0.01 and (s_plain < 0.2).sum() > 20  # measured: ~0, 64 triangles
-    assert s_guard.min() > 0.28 and guarded.one_to_one and guarded.n_folded == 0  # measured 0.297
-    # The price: a little more edge strain (12.15 % -> 12.37 % measured), nothing like a rescale.
-    assert plain.distortion.edge_strain_rms < guarded.distortion.edge_strain_rms < 1.05 * plain.distortion.edge_strain_rms
+    path = CORPUS / "bff_bunnyhead.obj"
+    if not path.is_file():
+        pytest.skip(f"corpus mesh {path} is absent")
+    mesh = read_mesh(path)
+    plain = patterns.flatten_mesh(mesh.vertices, mesh.faces, energy="arap")
+    guarded = patterns.flatten_mesh(mesh.vertices, mesh.faces, energy="arap", min_stretch=0.3)
+    assert plain.distortion.stretch_min < 1e-3  # measured 1e-7
+    assert guarded.distortion.stretch_min > 0.25 and guarded.one_to_one and guarded.n_folded == 0
+    # The price: more strain than the crushed layout, nothing like a rescale.
+    assert plain.distortion.strain_rms < guarded.distortion.strain_rms < 1.5 * plain.distortion.strain_rms
     # Where no triangle is squeezed that far the guard is zero: the same layout.
     v, f = surfaces.spherical_cap(radius=100.0, half_angle=30.0, n_faces=1000)
     assert np.array_equal(patterns.flatten_mesh(v, f, min_stretch=0.3).uv, patterns.flatten_mesh(v, f).uv)
@@ -344,12 +327,36 @@ def test_min_stretch_must_be_between_0_and_1(bad):
         patterns.flatten_mesh(v, f, method="isometric", min_stretch=0.3)
 
 
-def test_guard_gradient_matches_finite_differences():
-    from patterns.flatten.relax import _StressBarrier
+def test_one_surface_meshed_three_ways_gives_one_strain():
+    """The 30-degree cap of a 500 mm sphere: our CAD mesher, a sliced icosphere and a sliced
+    UV sphere (a pole fan of slivers).  The area-weighted principal strain is the surface's:
+    the three agree within 15 % (measured 1.419 / 1.412 / 1.434 %).  The edge-strain engine
+    of earlier versions gave 0.94 / 1.57 / 3.11 % (the first slit to the pole)."""
+    import trimesh
 
-    v, f, conn, uv, rng = _perturbed_cap(seed=4, scale=0.3)  # squeezes some triangles past the floor
-    lengths = np.linalg.norm(v[conn.edges[:, 1]] - v[conn.edges[:, 0]], axis=1)
-    energy = _StressBarrier(v, f, conn.edges, lengths, min_stretch=0.99)
-    guard, _ = energy.guard(uv)
-    assert guard > 0  # some triangles are past the floor, so the guard is active
-    _assert_gradient_matches_finite_differences(energy, uv, rng)
+    from .test_tessellate import _cap_face
+
+    radius, h = 500.0, 500.0 * np.cos(np.radians(30))
+
+    def sliced(mesh):
+        keep = np.flatnonzero(mesh.triangles_center[:, 2] > h)
+        f = mesh.faces[keep]
+        used = np.unique(f)
+        index = np.full(len(mesh.vertices), -1)
+        index[used] = np.arange(len(used))
+        return np.asarray(mesh.vertices)[used], index[f]
+
+    panel = patterns.load(_cap_face(radius, 30.0)).panels[0]
+    meshes = [(panel.vertices, panel.faces), sliced(trimesh.creation.icosphere(subdivisions=6, radius=radius)),
+              sliced(trimesh.creation.uv_sphere(radius=radius, count=[180, 180]))]
+    rms = [patterns.flatten_mesh(v, f).distortion.strain_rms for v, f in meshes]
+    assert max(rms) / min(rms) <= 1.15
+    # Independent reference: the azimuthal equidistant map (radial stretch 1,
+    # circumferential phi / sin phi) is one layout of the cap, so the least strain is
+    # below its RMS, computed by quadrature: sqrt(int (phi/sin phi - 1)^2 sin phi / 2 int sin phi).
+    from scipy.integrate import quad
+
+    a = np.radians(30)
+    bound = np.sqrt(quad(lambda p: (p / np.sin(p) - 1) ** 2 * np.sin(p), 1e-12, a)[0]
+                    / (2 * quad(np.sin, 0, a)[0]))  # 1.90 %
+    assert all(x < bound for x in rms)

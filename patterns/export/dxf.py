@@ -123,13 +123,10 @@ class _PanelGeometry:
         self.label_at = inside
         box = np.ptp(self.seam_loops[0], axis=0)
         self.text_height = text_height if text_height else float(np.clip(0.03 * box.max(), 2.0, 12.0))
-        from ..measure import strain_summary, triangle_strains
+        from ..measure import strain_stats
 
-        # The same numbers as patterns.check's report (an exact development has no strain).
-        if flat.flattening.method == "exact":
-            self.strain_rms = self.strain_max = 0.0
-        else:
-            self.strain_rms, self.strain_max, _ = strain_summary(triangle_strains(flat.vertices, flat.faces, flat.uv))
+        stats = strain_stats(flat.strains)  # the same numbers as patterns.check's report
+        self.strain_rms, self.strain_max = stats.rms, stats.max
         self.box = np.r_[uv.min(axis=0), uv.max(axis=0)]
 
 

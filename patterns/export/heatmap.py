@@ -76,8 +76,6 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.figure import Figure
 
-    from ..measure import triangle_strains
-
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in HEAT_MAP_FORMATS:
@@ -86,7 +84,7 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
                                        and max_strain > 0):
         raise InputError(f"{path}: max_strain must be a positive number, got {max_strain!r}")
     offsets = display_offsets(pattern)
-    strains = [triangle_strains(p.vertices, p.faces, p.uv) for p in pattern.panels]
+    strains = [p.strains for p in pattern.panels]
     worst = max(float(np.max(np.abs(s.dominant))) for s in strains)
     limit = float(max_strain) if max_strain is not None else max(worst, 1e-6)
     norm = TwoSlopeNorm(vcenter=0.0, vmin=-100.0 * limit, vmax=100.0 * limit)
@@ -94,7 +92,7 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
     ax = fig.add_subplot()
     mappable = None
     total_w = sum(float(s.area_3d.sum()) for s in strains)
-    rms = np.sqrt(sum(float(np.sum(s.area_3d * s.dominant**2)) for s in strains) / total_w)
+    rms = np.sqrt(sum(0.5 * float(s.area_3d @ (s.strain**2).sum(axis=1)) for s in strains) / total_w)
     for flat, s, off in zip(pattern.panels, strains, offsets):
         uv = flat.uv + off
         mappable = ax.tripcolor(uv[:, 0], uv[:, 1], flat.faces, facecolors=100.0 * s.dominant, cmap="RdBu_r",

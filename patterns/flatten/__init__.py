@@ -13,12 +13,16 @@ from functools import cached_property
 import numpy as np
 
 from ..check import Overlap, overlap_verdict
-from ..errors import FlattenError, InputError
+from threadpoolctl import threadpool_limits
+
+from ..errors import FlattenError, InputError, PatternsError
 from ..measure import Distortion, distortion, local_coordinates, signed_areas
-from ..mesh import _readonly, unique_edges, unique_ints, validate_mesh
+from ..mesh import _readonly, as_mesh_arrays, unique_edges, unique_ints, validate_mesh
 from . import grow
 from .embed import lscm, tutte_embedding
-from .relax import align_to_pins, best_scale, check_pins, relax
+from .energy import ENERGIES
+from .numbering import dissection_order, renumber, renumber_connectivity, spatial_order
+from .relax import align_to_pins, best_scale, check_lengths, check_pins, is_isometric, relax
 
 __all__ = ["METHODS", "Flattening", "flatten", "flatten_mesh"]
 
@@ -53,8 +57,15 @@ class Flattening:
     iterations : int
         ``"relaxed"`` only: relaxation iterations run (0 otherwise).
     converged : bool
-        ``"relaxed"``: the stress stopped decreasing (by the tolerance) and the
-        pins were reached within ``max_iterations``.  True for the growers.
+        ``"relaxed"``: the energy stopped decreasing (by the tolerance), the
+        pins were reached and the held lengths kept, within ``max_iterations``.
+        True for the growers.
+    energy : str
+        ``"relaxed"`` only: the energy minimised (``"arap"``, ``"hybrid"`` or
+        ``"symmetric-dirichlet"``; what ``"auto"`` chose); "" otherwise.
+    length_error : float
+        ``"relaxed"`` with ``lengths``: the largest ``|l_flat / l_held - 1|`` over
+        the held edges; 0 otherwise.
     """
 
     uv: np.ndarray
@@ -67,6 +78,8 @@ class Flattening:
     start: str = ""
     iterations: int = 0
     converged: bool = True
+    energy: str = ""
+    length_error: float = 0.0
 
     @property
     def one_to_one(self) -> bool:
@@ -80,13 +93,14 @@ class Flattening:
 
     @cached_property
     def distortion(self) -> Distortion:
-        """Edge strain, principal stretches, areas and boundary lengths."""
+        """Principal strains, edge strain, areas and boundary lengths."""
         return distortion(self.vertices, self.faces, self.uv, loops=self.loops)
 
 
 def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | None = None,
-                 pins=None, max_iterations: int = 500, tolerance: float = 1e-4,
-                 min_stretch: float | None = None, progress=None, name: str = "mesh") -> Flattening:
+                 pins=None, max_iterations: int = 500, tolerance: float = 1e-5,
+                 min_stretch: float | None = None, energy: str = "auto", lengths=None, progress=None,
+                 name: str = "mesh") -> Flattening:
     """Flatten a triangle mesh to the plane at true scale.
 
     Parameters
@@ -99,10 +113,9 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         or a disk with holes).
     method : {"relaxed", "isometric", "conformal"}
         ``"relaxed"`` (default): the ``"isometric"`` layout -- or, where that
-        overlaps itself, a conformal (LSCM) or Tutte layout -- relaxed towards
-        true edge lengths (least squared edge strain, with an annealed barrier
-        that keeps triangles open on the way) while every triangle keeps its
-        orientation and the boundary never crosses itself: the result is
+        overlaps itself, a conformal (LSCM) or Tutte layout -- relaxed to the
+        least area-weighted distortion (``energy``) while every triangle keeps
+        its orientation and the boundary never crosses itself: the result is
         always one-to-one.  Use it for patterns.  See
         :mod:`patterns.flatten.relax`.
 
@@ -128,19 +141,32 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         them; they are then reached step by step unless that would fold.
     max_iterations : int
         ``"relaxed"`` only: at most this many relaxation iterations (> 0).
-        Mildly curved parts converge in 10-25, heads and other strongly
-        curved parts that start from LSCM in 70-250.
+        Mildly curved parts converge in 6-15, heads and other strongly
+        curved parts that start from LSCM in 50-250.
     tolerance : float
-        ``"relaxed"`` only: stop when the summed squared edge strain falls by
-        less than this fraction per iteration (averaged over two; >= 0).
+        ``"relaxed"`` only: stop when the energy falls by less than this
+        fraction per iteration (averaged over two; >= 0).
     min_stretch : float in (0, 1), optional
         ``"relaxed"`` only: keep every triangle's smallest principal stretch
         near or above this (0.3 keeps each triangle at least about 30 % of its
-        size in every direction).  Least squared edge strain alone may press a
-        small region of a dome or a cup nearly flat (measured in
-        docs/benchmarks.md); this adds a guard that is zero until a triangle is
-        squeezed that far.  Parts without such a region come out unchanged; on
-        a hemisphere the edge-strain RMS rises by about 2 %.
+        size in every direction): a guard that is zero until a triangle is
+        squeezed that far.
+    energy : {"auto", "arap", "hybrid", "symmetric-dirichlet"}
+        ``"relaxed"`` only: the distortion minimised, each summed over the
+        triangles weighted by their 3D area (:mod:`patterns.flatten.energy`).
+        ``"arap"``: the squared principal strains, the material's strain
+        (libigl ARAP's energy).  ``"symmetric-dirichlet"``: SLIM's energy,
+        which never lets a triangle collapse.  ``"hybrid"``: half of each.
+        ``"auto"`` (default): ARAP, unless its fold-free minimum presses a
+        triangle flat (to below 1/1000 of its size: where the least-strain
+        layout would fold, as on a scanned head), then the hybrid from there.
+    lengths : tuple of ((k, 2) int, (k,) float[, (k,) int]), optional
+        ``"relaxed"`` only: edges of the mesh (vertex pairs) held at these
+        flat lengths, in the mesh unit -- the seams of a pattern
+        (:func:`patterns.flatten` holds every seam edge at its 3D length).
+        With a third array of group numbers, the edges of a group are held
+        in total instead of one by one.  ``Flattening.length_error`` says how
+        close they came.
     progress : callable, optional
         Called as ``progress(n_done, n_total)``: vertices placed by a grower,
         then iterations of the relaxation.
@@ -176,15 +202,70 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         raise InputError(f"{name}: max_iterations must be a positive integer, got {max_iterations!r}")
     if not (isinstance(tolerance, (int, float, np.floating)) and tolerance >= 0):
         raise InputError(f"{name}: tolerance must be a number >= 0, got {tolerance!r}")
-    v, f, conn = validate_mesh(vertices, faces, name=name)
-    if seed_face is None:
-        seed = grow.seed_face(v, f, conn)
-    else:
-        if isinstance(seed_face, bool) or not isinstance(seed_face, (int, np.integer)) or not 0 <= seed_face < len(f):
-            raise InputError(f"{name}: seed_face must be a face index in [0, {len(f)}), got {seed_face!r}")
-        seed = int(seed_face)
+    if energy not in ENERGIES:
+        raise InputError(f"{name}: unknown energy {energy!r}; choose one of {', '.join(ENERGIES)}")
+    if method != "relaxed" and (lengths is not None or energy != "auto"):
+        raise InputError(f"{name}: {'lengths' if lengths is not None else 'energy'} applies to method='relaxed' only")
+    v, f, num, conn = _working_mesh(vertices, faces, name)
+    if seed_face is not None and (isinstance(seed_face, bool) or not isinstance(seed_face, (int, np.integer))
+                                  or not 0 <= seed_face < len(f)):
+        raise InputError(f"{name}: seed_face must be a face index in [0, {len(f)}), got {seed_face!r}")
+    # The engine works in the working numbering: options that name vertices or faces follow it.
+    inv = None if num is None else num.vertex_inverse
+    if lengths is not None:
+        lengths = check_lengths(lengths, conn, name, numbering=inv)
     if pins is not None:
         pins = check_pins(pins, len(v), name)
+        pins = pins if num is None else (inv[pins[0]], pins[1])
+    wv, wf = (v, f) if num is None else (v[num.vertex], num.faces)
+    seed = grow.seed_face(wv, wf, conn) if seed_face is None else int(seed_face if num is None
+                                                                         else num.face_inverse[seed_face])
+    with threadpool_limits(limits=1, user_api="blas"):
+        # One BLAS thread: a sum split between threads rounds differently, and the
+        # pattern must not depend on the machine's thread count.
+        uv, extras = _engine(wv, wf, conn, seed, method, pins, lengths, progress, name, max_iterations=max_iterations,
+                             tolerance=tolerance, min_stretch=min_stretch, energy=energy)
+    loops = conn.loops
+    if num is not None:  # back to the input's numbering
+        uv, seed = np.ascontiguousarray(uv[num.vertex_inverse]), int(num.face[seed])
+        loops = tuple(_readonly(num.vertex[loop]) for loop in loops)
+    return Flattening(uv=_readonly(uv), vertices=_readonly(v), faces=_readonly(f), loops=loops, method=method,
+                      seed_face=seed, overlap=overlap_verdict(f, uv, loops), **extras)
+
+
+_SCATTERED = 0.25  # share of edges joining vertices more than n / 16 apart in the input's order
+_RENUMBER_FROM = 50_000  # vertices: smaller meshes fit in cache whatever their order
+
+
+def _working_mesh(vertices, faces, name):
+    """``(v, f, numbering or None, connectivity)``: the validated input and the numbering the engine works in.
+
+    A mesh whose edges mostly join vertices far apart in its own numbering
+    (numbered at random, say: 88 % of its edges span more than a sixteenth of
+    it, against none for a mesh numbered row by row or along its surface) is
+    renumbered along a space-filling curve before anything else, so that
+    validation, the growers and the relaxation read memory in order: their time
+    then hardly depends on how the input was numbered.  Other meshes are used
+    as they come, and so is any mesh under 50 000 vertices (it fits in cache in
+    any order).  Refusals name the input's own vertices and faces.
+    """
+    v, f = as_mesh_arrays(vertices, faces, name=name)
+    n = len(v)
+    span = np.abs(f[:, [0, 1, 2]] - f[:, [1, 2, 0]])
+    if n < _RENUMBER_FROM or np.mean(span > n // 16) <= _SCATTERED:
+        _, _, conn = validate_mesh(v, f, name=name)
+        return v, f, None, conn
+    num = renumber(spatial_order(v), f)
+    try:
+        _, _, conn = validate_mesh(v[num.vertex], num.faces, name=name)
+    except PatternsError:
+        validate_mesh(v, f, name=name)  # the same refusal, naming the input's vertices and faces
+        raise
+    return v, f, num, conn
+
+
+def _engine(v, f, conn, seed, method, pins, lengths, progress, name, **relax_options):
+    """Flatten the canonically numbered mesh: ``(uv (n, 2), extra Flattening fields)``."""
     z = local_coordinates(v, f)
     weights = 0.5 * np.abs((np.conj(z[:, 1]) * z[:, 2]).imag)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -196,7 +277,7 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
                                  rotations=rotations, progress=None if method == "relaxed" else progress)
     uv = np.column_stack([w.real, w.imag])
     if method == "relaxed":
-        return _relaxed(v, f, conn, uv, seed, z, pins, max_iterations, tolerance, progress, min_stretch)
+        return _relaxed(v, f, conn, uv, z, pins, lengths, progress, **relax_options)
     # Beyond ~1e154 the flat triangles' areas overflow double precision: such a
     # result cannot even be checked, so it is an error, not an answer.
     with np.errstate(over="ignore", invalid="ignore"):
@@ -206,20 +287,17 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
             f"{name}: the {method} grower diverged (flat coordinates beyond double precision); "
             f"use method='isometric'"
         )
-    return Flattening(
-        uv=_readonly(uv),
-        vertices=_readonly(v),
-        faces=_readonly(f),
-        loops=conn.loops,
-        method=method,
-        seed_face=seed,
-        overlap=overlap_verdict(f, uv, conn.loops),
-    )
+    return uv, {}
 
 
-def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progress, min_stretch) -> Flattening:
-    """Pick a one-to-one start (greedy, else LSCM, else Tutte) and relax it."""
-    start, label, barrier = greedy, "greedy", 1e-3
+def _relaxed(v, f, conn, greedy, z, pins, lengths, progress, **options):
+    """Pick a one-to-one start (greedy, else LSCM, else Tutte) and relax it: ``(uv, extra Flattening fields)``.
+
+    The relaxation runs on the mesh renumbered in a nested-dissection order of
+    the start (:mod:`patterns.flatten.numbering`): its time does not depend
+    on the input's numbering, nor on the part's placement in space.
+    """
+    start, label, barrier = greedy, "greedy", 0.0
     if not overlap_verdict(f, start, conn.loops).one_to_one:
         start, label = lscm(v, f, conn, local=z), "lscm"
         if not overlap_verdict(f, start, conn.loops).one_to_one:
@@ -229,27 +307,26 @@ def _relaxed(v, f, conn, greedy, seed, z, pins, max_iterations, tolerance, progr
         barrier = 0.1  # far from the answer: keep triangles open while it moves
     if pins is not None:
         start = align_to_pins(start, *pins)  # a rigid motion: still one-to-one
-    result = relax(v, f, conn, start, pins=pins, barrier=barrier, max_iterations=max_iterations, tolerance=tolerance,
-                   progress=progress, local=z, min_stretch=min_stretch)
-    uv = np.array(result.uv)
-    return Flattening(
-        uv=_readonly(uv),
-        vertices=_readonly(v),
-        faces=_readonly(f),
-        loops=conn.loops,
-        method="relaxed",
-        seed_face=seed,
-        overlap=overlap_verdict(f, uv, conn.loops),
-        start=label,
-        iterations=result.iterations,
-        converged=result.converged,
-    )
+    elif lengths is None and label == "greedy" and is_isometric(v, f, start, local=z):
+        # Already exact (a developable part): nothing to relax, renumber or factorise.
+        return start, dict(start=label, iterations=0, converged=True,
+                           energy="arap" if options["energy"] == "auto" else options["energy"])
+    num = renumber(dissection_order(start, conn.edges), f)
+    inv = num.vertex_inverse
+    if pins is not None:
+        pins = (inv[pins[0]], pins[1])
+    if lengths is not None:
+        lengths = (inv[lengths[0]], *lengths[1:])
+    result = relax(v[num.vertex], num.faces, renumber_connectivity(conn, num), start[num.vertex], pins=pins,
+                   lengths=lengths, barrier=barrier, progress=progress, local=z[num.face], **options)
+    return np.array(result.uv[inv]), dict(start=label, iterations=result.iterations, converged=result.converged,
+                                          energy=result.energy, length_error=result.length_error)
 
 
 def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: float = 0.0, k_factor: float = 0.5,
-            reference: str = "mid", grain=None, max_strain: float | None = None, max_darts: int = 60,
-            max_iterations: int = 500, tolerance: float = 1e-6, min_stretch: float | None = None,
-            progress=None):
+            reference: str = "mid", grain=None, seams: str = "true", ease=None, max_strain: float | None = None,
+            max_darts: int = 60, max_iterations: int = 500, tolerance: float = 1e-6, min_stretch: float | None = None,
+            energy: str = "auto", progress=None):
     """Lay every panel of a model flat at true scale.
 
     Parameters
@@ -279,6 +356,20 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         points along +Y.  One direction for all panels, or one per panel name
         (panels not named keep their orientation).  Only rotations: nothing
         is scaled.
+    seams : {"true", "total", "free"}
+        ``"true"`` (default): every seam edge of a freeform panel is held flat
+        at its 3D length (``method="relaxed"``; :mod:`patterns.flatten.seams`),
+        so that each seam is as long flat as in 3D and its two sides match
+        point by point, also against an exactly developed neighbour.
+        ``"total"``: only each seam side's total length is held (less strain;
+        points along the seam may drift a few mm from their mate's).
+        ``"free"``: the boundary takes the least-strain lengths (seams come
+        out longer or shorter, and the two sides of a seam differ).
+    ease : Ease or sequence of Ease, optional
+        Deliberate extra (or less) length on one side of a seam
+        (:class:`~patterns.flatten.seams.Ease`): that side is held at its 3D
+        length times ``1 + ratio``, plus ``mm``.  An eased side of a planar,
+        cylindrical or conical panel sends that panel through the engine.
     max_strain : float, optional
         Largest acceptable triangle strain (0.03 = 3 %).  A freeform panel that
         comes out above it is cut, one dart at a time, from the outline to its
@@ -288,16 +379,9 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         Every cut is in :attr:`FlatPanel.darts`.
     max_darts : int
         At most this many darts per panel.
-    max_iterations, tolerance
+    max_iterations, tolerance, min_stretch, energy
         ``"relaxed"`` only; see :func:`flatten_mesh`.  The tolerance here is
-        1e-6 (``flatten_mesh``: 1e-4): a pattern is relaxed to convergence, so
-        that the two flat sides of a seam come out as close as the surface
-        allows (on the cup sample 0.091-0.096 % apart, against up to 0.13 %
-        at 1e-4), for about 1.5 times the iterations.
-    min_stretch : float in (0, 1), optional
-        ``"relaxed"`` only; see :func:`flatten_mesh`: no triangle pressed below
-        this in any direction (a dome relaxed to 1e-6 without it can lose a
-        tenth of its area at the pole; see docs/benchmarks.md).
+        1e-6 (``flatten_mesh``: 1e-5): a pattern is relaxed to convergence.
     progress : callable, optional
         ``progress(panels_done, n_panels)`` after each panel.
 
@@ -305,7 +389,8 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
     -------
     patterns.Pattern
         One :class:`~patterns.FlatPanel` per panel (vertex ``i`` of the panel at
-        ``uv[i]``), and each seam with its flat length on either side.
+        ``uv[i]``), and each seam with its flat length on either side and the
+        length it was held at.
 
     Raises
     ------
@@ -317,6 +402,7 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
     from ..model import Model
     from ..pattern import FlatPanel, FlatSeam, Pattern
     from .develop import neutral_offset
+    from .seams import SeamLengths, held_lengths, seam_mode, validate_ease
 
     if not isinstance(model, Model):
         raise InputError(f"flatten() takes a patterns.Model (from patterns.load), got {type(model).__name__}")
@@ -324,66 +410,105 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         raise InputError(f"unknown flattening method {method!r}; choose one of {', '.join(METHODS)}")
     offset = neutral_offset(thickness, k_factor, reference, name=model.name)
     grains = _grain_table(grain, model)
+    mode = seam_mode(seams)
+    eased = validate_ease(ease, model)
+    if eased and (mode is SeamLengths.FREE or method != "relaxed"):
+        raise InputError(f"{model.name}: ease needs seams='true' or 'total' and method='relaxed'")
     if max_strain is not None and (isinstance(max_strain, bool) or not isinstance(max_strain, (int, float))
                                    or not np.isfinite(max_strain) or max_strain <= 0):
         raise InputError(f"{model.name}: max_strain must be a positive number, got {max_strain!r}")
     if isinstance(max_darts, bool) or not isinstance(max_darts, (int, np.integer)) or max_darts < 0:
         raise InputError(f"{model.name}: max_darts must be an integer >= 0, got {max_darts!r}")
-    flat = []
+    eased_panels = {model.seams[s].panels[side] for s, side in eased}
+    flat, targets = [], {}
     for i, panel in enumerate(model.panels):
         name = f"{model.name}: panel {panel.name}"
         darts = ()
-        if exact and panel.surface is not None:
+        if exact and panel.surface is not None and i not in eased_panels:
             result = _developed(panel, offset, name)
         else:
             vertices = _offset_along_normals(panel, offset) if offset else panel.vertices
-            result = flatten_mesh(vertices, panel.faces, method=method, max_iterations=max_iterations,
-                                  tolerance=tolerance, min_stretch=min_stretch, name=name)
+            held = None
+            if method == "relaxed":
+                held = held_lengths(model, i, vertices, eased, mode, mesh_edges=unique_edges(panel.faces))
+            options = dict(method=method, max_iterations=max_iterations, tolerance=tolerance,
+                           min_stretch=min_stretch, energy=energy, name=name)
+            result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
             if max_strain is not None:
-                result, darts = _with_darts(result, max_strain, max_darts, method, max_iterations, tolerance,
-                                            min_stretch, name)
+                result, darts = _with_darts(result, max_strain, max_darts, held, options)
+        targets.update(_side_targets(model, i, result, eased, mode))
         if panel.name in grains:
             result = _turn_to_grain(result, grains[panel.name])
         flat.append(FlatPanel(panel.name, panel, result, darts=darts))
         if progress is not None:
             progress(i + 1, len(model.panels))
-    seams = []
+    seams_out = []
     for seam in model.seams:
-        lengths = tuple(
-            float(np.linalg.norm(np.diff(flat[p].uv[idx], axis=0), axis=1).sum())
-            for p, idx in zip(seam.panels, seam.vertices)
-        )
-        seams.append(FlatSeam(seam, lengths))
-    return Pattern(model=model, panels=tuple(flat), seams=tuple(seams), method=method,
+        lengths = tuple(_flat_length(flat[p].flattening, idx) for p, idx in zip(seam.panels, seam.vertices))
+        held_at = tuple(targets.get((seam.id, side)) for side in range(2))
+        seams_out.append(FlatSeam(seam, lengths, None if None in held_at else held_at))
+    return Pattern(model=model, panels=tuple(flat), seams=tuple(seams_out), method=method,
                    thickness=float(thickness), k_factor=float(k_factor), reference=reference)
 
 
-_DART_SLACK = 1.05  # a dart is kept if the edge-strain RMS after it is at most this times the lowest so far
+def _flat_length(result: Flattening, idx) -> float:
+    """Flat length of a seam side given by its vertices, segment by segment along the mesh's edges."""
+    from .seams import seam_edges
+
+    idx = np.asarray(idx, dtype=np.int64)
+    pairs = seam_edges(result.vertices, unique_edges(result.faces), np.column_stack([idx[:-1], idx[1:]]))
+    return float(np.linalg.norm(result.uv[pairs[:, 1]] - result.uv[pairs[:, 0]], axis=1).sum())
+
+
+def _side_targets(model, panel: int, result: Flattening, eased: dict, mode) -> dict:
+    """``{(seam id, side): flat length the side should have}`` for the seams of one flattened panel.
+
+    The 3D length of the side's polyline (on the surface that was flattened)
+    times its ease, where the length was held (seams "true") or kept by an
+    exact development; nothing for a free seam.
+    """
+    from .seams import SeamLengths
+
+    if mode is SeamLengths.FREE or result.method not in ("relaxed", "exact"):
+        return {}
+    out = {}
+    for seam in model.seams_of(panel):
+        for side, p in enumerate(seam.panels):
+            if p == panel:
+                pts = result.vertices[np.asarray(seam.vertices[side])]
+                # 3D: the copies of a point coincide, so the polyline is measured as it is.
+                length = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
+                out[(seam.id, side)] = length * eased.get((seam.id, side), 1.0)
+    return out
+
+
+_DART_SLACK = 1.05  # a dart is kept if the strain RMS after it is at most this times the lowest so far
 _DART_REFUSALS = 4  # consecutive refused darts before the loop gives up
 
 
-def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_iterations, tolerance, min_stretch,
-                name):
+def _with_darts(result: Flattening, limit: float, max_darts: int, held, options: dict):
     """Cut darts into a flattening until its triangle strain is within ``limit``.
 
     Greedy: each round finds the vertices next to a triangle above the limit,
     takes the one deepest inside (farthest from the outline along the mesh),
     cuts along the shortest path of edges from the outline to it, and flattens
-    again.  A dart is kept only if the edge-strain RMS after it (the
-    relaxation's objective, which a cut can only lower at the optimum) is at
-    most ``_DART_SLACK`` times the lowest so far; otherwise the cut is undone
-    and the next deepest vertex is tried (after ``_DART_REFUSALS`` refusals in
-    a row the loop stops).  Without that, one cut whose flaps overlap when laid
-    flat (LSCM then overlaps, and the relaxation starts from Tutte's layout)
-    sent every later round to 50-300 % strain on a hemisphere.  The worst
-    triangle strain is not the test: it moves about from cut to cut, and
-    darts that raise it for a round are often what brings it down later.
-    Returns ``(flattening, darts)``.
+    again (``options``: those of :func:`flatten_mesh`; ``held``: the seam
+    lengths, remapped onto each cut mesh).  A dart is kept only if the
+    strain RMS after it (the relaxation's objective, which a cut can only
+    lower at the optimum) is at most ``_DART_SLACK`` times the lowest so far;
+    otherwise the cut is undone and the next deepest vertex is tried (after
+    ``_DART_REFUSALS`` refusals in a row the loop stops).  Without that, one
+    cut whose flaps overlap when laid flat (LSCM then overlaps, and the
+    relaxation starts from Tutte's layout) sent every later round to
+    50-300 % strain on a hemisphere.  The worst triangle strain is not the
+    test: it moves about from cut to cut, and darts that raise it for a round
+    are often what brings it down later.  Returns ``(flattening, darts)``.
     """
     from ..cut import cut_along
+    from .seams import seam_edges
 
     darts = []
-    lowest = result.distortion.edge_strain_rms
+    lowest = _strain_rms(result)
     refused = set()  # target vertices whose dart made things worse (indices survive later cuts)
     in_a_row = 0
     depths = _strained_depths(result, limit)  # recomputed only when a dart is kept
@@ -402,18 +527,25 @@ def _with_darts(result: Flattening, limit: float, max_darts: int, method, max_it
         while pred[path[-1]] >= 0:
             path.append(int(pred[path[-1]]))
         path = np.asarray(path[::-1], dtype=np.int64)  # from the outline inwards
-        cut = cut_along(result.vertices, result.faces, path, name=name)
-        after = flatten_mesh(cut.vertices, cut.faces, method=method, max_iterations=max_iterations,
-                             tolerance=tolerance, min_stretch=min_stretch, name=name)
-        rms = after.distortion.edge_strain_rms
+        cut = cut_along(result.vertices, result.faces, path, name=options["name"])
+        cut_held = None if held is None else (seam_edges(cut.vertices, unique_edges(cut.faces), held[0]), *held[1:])
+        after = flatten_mesh(cut.vertices, cut.faces, lengths=cut_held, **options)
+        rms = _strain_rms(after)
         if rms <= _DART_SLACK * lowest:
             darts.append(path)
-            result, lowest, in_a_row = after, min(lowest, rms), 0
+            result, lowest, in_a_row, held = after, min(lowest, rms), 0, cut_held
             depths = _strained_depths(result, limit)
         else:
             refused.add(target)
             in_a_row += 1
     return result, tuple(np.asarray(d) for d in darts)
+
+
+def _strain_rms(result: Flattening) -> float:
+    """The area-weighted RMS of the principal strains of a flattening."""
+    from ..measure import strain_rms
+
+    return strain_rms(result.vertices, result.faces, result.uv)
 
 
 def _strained_depths(result: Flattening, limit: float):

@@ -178,7 +178,8 @@ def seed_face(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity) -> in
     -------
     int
         Index of the face whose corners have the largest summed edge-path
-        distance to the nearest boundary vertex.
+        distance to the nearest boundary vertex (the lowest index among
+        faces within round-off of it).
     """
     e = conn.edges
     length = edge_lengths(vertices, e)
@@ -186,7 +187,10 @@ def seed_face(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity) -> in
     graph = coo_matrix((length, (e[:, 0], e[:, 1])), shape=(n, n)).tocsr()
     sources = unique_ints(np.concatenate(conn.loops))
     dist = csgraph.dijkstra(graph, directed=False, indices=sources, min_only=True)
-    return int(np.argmax(dist[faces].sum(axis=1)))
+    depth = dist[faces].sum(axis=1)
+    # Faces as deep as the deepest up to round-off (a symmetric part has many)
+    # are ties: the first of them, not whichever round-off favours.
+    return int(np.flatnonzero(depth >= depth.max() * (1.0 - 1e-9))[0])
 
 
 def seed_layout(z_seed: np.ndarray) -> np.ndarray:

@@ -1,31 +1,31 @@
-"""Fold-free relaxation of a flat layout towards true edge lengths.
+"""Fold-free relaxation of a flat layout: least distortion of the surface-to-plane map.
 
-The relaxation minimises the edge-length stress
-
-    S(u) = sum over edges of (|u_i - u_j| / l_ij - 1)**2,
-
-the sum of squared edge strains, while every triangle keeps its orientation and
-the flat boundary never crosses itself.
+The relaxation minimises an area-weighted distortion energy of the map from
+the surface to the plane (:mod:`patterns.flatten.energy`) -- by default
+``"arap"``, the sum of squared principal strains weighted by 3D area, the
+material's strain -- while every triangle keeps its orientation and the flat
+boundary never crosses itself.  Chosen edges (the seams of a pattern) can be
+held at target lengths.
 
 Method
 ------
-* **Energy.**  ``E = S + mu * B`` with the collapse barrier
-  ``B = sum_t w_t |J_t^-1|_F**2`` (``J_t`` the triangle's Jacobian from its 3D
-  frame to the plane; 2 for a rigid motion, unbounded as a triangle
-  collapses).  ``mu`` starts at ``barrier`` and is cut tenfold each time
-  progress stalls; the last stage has ``mu = 0`` and minimises the stress
-  alone.  The barrier matters when the start is far from the answer (a
-  conformal layout of a head, whose ears are shrunk a hundredfold): without it
-  the stress squeezes triangles flat on the way and the steps stall.
-* **Steps.**  L-BFGS whose initial inverse Hessian is ``L^-1 / 2``, ``L`` the
-  graph Laplacian with weights ``1 / l**2`` (the stress's curvature at the
-  answer), factorised once with SuperLU (in single precision: it only shapes
-  the steps).  While the barrier is strong its curvature is added to the
-  weights every few iterations and the matrix refactorised in double
-  precision by qdldl's ``L D L^T``, whose ordering and elimination tree are
-  kept from the first refactorisation so that only the numbers are factorised
-  (:class:`~patterns.flatten.embed.LDL`; a scalar version of SLIM's proxy).  One solve per iteration; the L-BFGS memory is kept until the
-  matrix changes.
+* **Energy.**  ``E + mu B + G + S``: the distortion ``E``; the collapse barrier
+  ``B = sum_t W_t |J_t^-1|^2``, whose weight ``mu`` starts at ``barrier`` and
+  is cut tenfold each time progress stalls, down to 0 in the last stage (it
+  keeps triangles open while a far start -- the conformal layout of a head --
+  moves towards the answer); the optional guard ``G`` against crushed
+  triangles (``min_stretch``); the optional seam term ``S``, an augmented
+  Lagrangian whose multipliers are updated each time the last stage
+  converges, until every held edge is within ``length_tolerance`` of its
+  target.
+* **Steps.**  L-BFGS whose initial inverse Hessian is ``K^-1``, ``K`` the
+  energy's curvature at an isometry: the cotangent Laplacian (the Hessian of
+  ``sum_t W_t |J_t|^2``), with the seam term's stiffness added along the held
+  edges.  While the barrier is strong, or for the symmetric Dirichlet energy
+  where triangles are squeezed, each triangle's block is stiffened by its
+  ``1 + 3 mu / sigma_min**4`` and the matrix refactorised numerically only
+  (qdldl's ``L D L^T``, ordering and elimination tree kept; a scalar version
+  of SLIM's proxy).  The L-BFGS memory is kept until the matrix changes.
 * **Line search.**  Each step is capped at 0.9 of the first time any triangle
   would flip (exact quadratic roots, :func:`flip_free_steps`), then halved until
   the energy drops (Armijo) and the boundary loops are still a valid polygon
@@ -46,18 +46,23 @@ import shapely
 
 from ..check import crossing_segments
 from ..errors import InputError
-from ..measure import local_coordinates, signed_areas
+from ..measure import signed_areas
 from ..mesh import Connectivity, edge_lengths
 from .embed import LDL, LDLFactor, factorize
+from .energy import ENERGIES, Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, dot, frames
 
 _WINDOW = 2  # iterations over which progress is judged
 _STAGE_TOLERANCE = 30.0  # a barrier stage ends at this many times the tolerance
-_REFRESH = 5  # iterations between refactorisations while the barrier is strong
+_REFRESH = 5  # iterations between refactorisations while the matrix is stiffened
 _MEMORY = 8  # L-BFGS pairs kept
 _DROP = 0.1  # the barrier weight is multiplied by this at each new stage
-_WEAKEST = 1e-5  # the last barrier stage before the stress alone
+_WEAKEST = 1e-5  # the last barrier stage before the energy alone
+_SEAM_RHO = 300.0  # seam penalty weight, relative to the held edge's triangle (30: slow rounds; 1000: stiffer steps)
+_SEAM_ROUNDS = 20  # most multiplier updates
+_CRUSHED = 1e-3  # "auto": ARAP's layout with a triangle squeezed below this stretch is redone with the hybrid
+_PROBE = 10.0  # "auto" from a far start: the first ARAP run stops at this many times the tolerance
 
-__all__ = ["Relaxation", "align_to_pins", "best_scale", "flip_free_steps", "relax"]
+__all__ = ["ENERGIES", "Relaxation", "align_to_pins", "best_scale", "flip_free_steps", "is_isometric", "relax"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,16 +74,25 @@ class Relaxation:
     uv : (n, 2) float64
     iterations : int
     converged : bool
-        The relative decrease of the stress fell below the tolerance (and the
-        pins, if any, were reached) before ``max_iterations``.
+        The relative decrease of the energy fell below the tolerance, the pins
+        (if any) were reached and the held edges (if any) came within their
+        tolerance, before ``max_iterations``.
+    length_error : float
+        Largest ``|l_flat / l_target - 1|`` over the held edges (0 without any).
+    energy : str
+        The energy minimised: ``"arap"``, ``"hybrid"`` or ``"symmetric-dirichlet"``
+        (what ``"auto"`` chose).
     """
 
     uv: np.ndarray
     iterations: int
     converged: bool
+    length_error: float = 0.0
+    energy: str = "arap"
 
 
-def flip_free_steps(faces: np.ndarray, uv: np.ndarray, step: np.ndarray, *, horizon: float = np.inf) -> np.ndarray:
+def flip_free_steps(faces: np.ndarray, uv: np.ndarray, step: np.ndarray, *, horizon: float = np.inf,
+                    corners: tuple | None = None) -> np.ndarray:
     """Largest ``t`` per triangle such that ``uv + s * step`` keeps it positive for all ``s < t``.
 
     The signed area along the step is the quadratic ``a2 t**2 + a1 t + a0``
@@ -91,17 +105,20 @@ def flip_free_steps(faces: np.ndarray, uv: np.ndarray, step: np.ndarray, *, hori
     horizon : float
         Only roots below this matter: triangles whose area stays positive up to
         ``horizon`` get ``inf`` without solving (much faster when most are safe).
+    corners : tuple of three (m,) int64, optional
+        ``faces``' columns, contiguous, if at hand (faster gathers).
 
     Returns
     -------
     (m,) float64
     """
     # Column gathers: several times faster than gathering (m, 3, 2) blocks.
-    i, j, k = faces[:, 0], faces[:, 1], faces[:, 2]
-    x, y, dx, dy = uv[:, 0], uv[:, 1], step[:, 0], step[:, 1]
-    x0, y0, dx0, dy0 = x[i], y[i], dx[i], dy[i]
-    e1x, e1y, e2x, e2y = x[j] - x0, y[j] - y0, x[k] - x0, y[k] - y0
-    d1x, d1y, d2x, d2y = dx[j] - dx0, dy[j] - dy0, dx[k] - dx0, dy[k] - dy0
+    i, j, k = corners if corners is not None else (np.ascontiguousarray(faces[:, c]) for c in range(3))
+    x, y = np.ascontiguousarray(uv[:, 0]), np.ascontiguousarray(uv[:, 1])
+    dx, dy = np.ascontiguousarray(step[:, 0]), np.ascontiguousarray(step[:, 1])
+    x0, y0, dx0, dy0 = x.take(i), y.take(i), dx.take(i), dy.take(i)
+    e1x, e1y, e2x, e2y = x.take(j) - x0, y.take(j) - y0, x.take(k) - x0, y.take(k) - y0
+    d1x, d1y, d2x, d2y = dx.take(j) - dx0, dy.take(j) - dy0, dx.take(k) - dx0, dy.take(k) - dy0
     a0 = e1x * e2y - e1y * e2x
     a1 = e1x * d2y - e1y * d2x + d1x * e2y - d1y * e2x
     a2 = d1x * d2y - d1y * d2x
@@ -153,9 +170,10 @@ def align_to_pins(uv: np.ndarray, index: np.ndarray, target: np.ndarray) -> np.n
 
 
 def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np.ndarray, *,
-          pins=None, barrier: float = 1e-3, max_iterations: int = 500, tolerance: float = 1e-4,
-          progress=None, local=None, min_stretch=None) -> Relaxation:
-    """Relax a one-to-one layout towards true edge lengths, keeping it one-to-one.
+          energy: str = "auto", pins=None, lengths=None, length_tolerance: float = 1e-4, barrier: float = 1e-3,
+          max_iterations: int = 500, tolerance: float = 1e-4, progress=None, local=None,
+          min_stretch=None) -> Relaxation:
+    """Relax a one-to-one layout towards least distortion, keeping it one-to-one.
 
     See the module docstring for the method.
 
@@ -166,18 +184,32 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     conn : Connectivity
     start : (n, 2) float64
         A layout without folded triangles and with valid boundary loops.
+    energy : {"auto", "arap", "hybrid", "symmetric-dirichlet"}
+        The distortion minimised (:mod:`patterns.flatten.energy`).  ``"auto"``
+        minimises ARAP, the squared principal strains; where its fold-free
+        minimum presses a triangle flat (a stretch below 1e-3: the layout
+        that least strains the material would fold there), it goes on from
+        that layout with the hybrid energy, which holds triangles open.
     pins : tuple of ((k,) int, (k, 2) float), optional
         Vertices to hold and their flat positions (libigl's ``b, bc``).  They
         are approached step by step first; if reaching them would fold or
         overlap the pattern they stop short (``converged`` is then False).
+    lengths : tuple of ((k, 2) int, (k,) float[, (k,) int]), optional
+        Edges (each an edge of the mesh) and the flat lengths to hold them at,
+        in the mesh unit: the seams of a pattern.  With a third array, the
+        edges of one group are held in total (a seam side's length), not one
+        by one.
+    length_tolerance : float
+        The held lengths are done when every group's ``|l_flat / l_target - 1|``
+        is below this (> 0).
     barrier : float
-        Starting barrier weight ``mu`` (>= 0): 0.1 for a start far from the
-        answer (a conformal or Tutte layout), 1e-3 for a near one (the greedy
-        layout); 0 minimises the stress alone from the start.
+        Starting barrier weight ``mu`` (>= 0) of the ARAP energy: 0.1 for a
+        start far from the answer (a conformal or Tutte layout), 0 for a near
+        one (the greedy layout).  The other energies are barriers themselves.
     max_iterations : int
         > 0; pin travel and quasi-Newton iterations together.
     tolerance : float
-        Stop when the stress falls by less than this fraction per iteration
+        Stop when the energy falls by less than this fraction per iteration
         (averaged over two); a barrier stage ends at 30 times this.
     progress : callable, optional
         ``progress(iteration, max_iterations)`` after each iteration.
@@ -186,7 +218,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         hand (computed otherwise).
     min_stretch : float in (0, 1), optional
         Guard against crushed triangles: every stage, the last included, adds
-        ``sum_t w_t max(0, |J_t^-1|^2 - f)**2`` with ``f = 1 + 1 / min_stretch**2``
+        ``sum_t W_t max(0, |J_t^-1|^2 - f)**2`` with ``f = 1 + 1 / min_stretch**2``
         (the value of a triangle squeezed to ``min_stretch`` one way and kept
         the other), which is zero wherever no triangle is squeezed that far.
 
@@ -195,326 +227,350 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     Relaxation
     """
     n = len(vertices)
-    e = conn.edges
-    length = edge_lengths(vertices, e)
     uv = np.array(start, dtype=np.float64)
-    floor = 1e-20 * len(length)  # RMS edge strain 1e-10: round-off level
-    if pins is None and np.sum((edge_lengths(uv, e) / length - 1) ** 2) <= floor:
-        uv.setflags(write=False)  # already exact (a developable part): nothing to relax
-        return Relaxation(uv, 0, True)
-    weight = 1.0 / length**2
+    fr = frames(vertices, faces, local=local)
+    seam, seam_index = _seam_term(n, conn, fr, lengths)
+    floor = 1e-20 * len(faces)  # RMS strain 1e-10: round-off level
+    if pins is None and seam is None and _isometric(fr, uv, floor):
+        uv.setflags(write=False)  # already exact (a developable part): nothing to relax or factorise
+        return Relaxation(uv, 0, True, energy="arap" if energy == "auto" else energy)
     free = np.ones(n, dtype=bool)
-    if pins is None:
-        # The stress does not see translations: tie vertex 0 softly.  For the
-        # preconditioner only; the energy itself has no anchor term.
-        anchor = float(weight.mean())
-        system = _laplacian(n, e, weight, anchor=anchor)
-        iterations = 0
-    else:
+    iterations = 0
+    if pins is not None:
         pin_index, pin_target = pins
         free[pin_index] = False
-        laplacian = _laplacian(n, e, weight)
-        system = laplacian[free][:, free]
-        uv, iterations = _travel_to_pins(faces, conn.loops, e, length, weight, laplacian, free, uv, pin_index,
-                                         pin_target, max_iterations, progress)
+        uv, iterations = _travel_to_pins(faces, conn.loops, conn.edges, edge_lengths(vertices, conn.edges), free, uv,
+                                         pin_index, pin_target, max_iterations, progress)
         if not np.allclose(uv[pin_index], pin_target, rtol=0, atol=1e-9 * _size(uv)):
             uv.setflags(write=False)
-            return Relaxation(uv, iterations, False)
+            return Relaxation(uv, iterations, False, _length_error(seam, uv), "arap" if energy == "auto" else energy)
         uv[pin_index] = pin_target
-    # The preconditioner only shapes the steps (energy, gradients and line
-    # search are double precision): the plain Laplacian is factorised in
-    # single precision, a third faster to factorise and to solve with, with
-    # the same iterations and result to 4 digits at 100k and 1M faces.  The
-    # barrier-stiffened refactorisations below, whose weights span up to twelve
-    # orders of magnitude, stay in double.
-    lu = factorize(system, single=True)
-    energy = _StressBarrier(vertices, faces, e, length, local=local, min_stretch=min_stretch)
-    stiffened = []  # the _StiffLaplacian, made at the first refactorisation
-
-    def refactor(u, mu):
-        """The Laplacian with the barrier's curvature added to its weights, factorised."""
-        stiff = energy.barrier_stiffness(u, mu)
-        extra = np.zeros(len(e))
-        for k in range(3):
-            extra += np.bincount(conn.face_edges[:, k], stiff, len(e))
-        if np.mean(extra > 1.0) < 0.1:
-            # The barrier at most doubles the curvature of under a tenth of the
-            # edges (a few squeezed triangles): not worth a factorisation.
-            return lu
-        if not stiffened:
-            stiffened.append(_StiffLaplacian(e, free, anchor=anchor if pins is None else 0.0))
-        return stiffened[0].factorize(weight * (1.0 + 0.5 * extra))
-
-    uv, used, converged = _quasi_newton(energy, faces, conn.loops, uv, free, lu, refactor=refactor, barrier=barrier,
-                                        max_iterations=max_iterations - iterations, tolerance=tolerance,
-                                        floor=floor, progress=progress, offset=iterations,
-                                        total=max_iterations)
+    guard = InverseTerm(fr, 1.0 + 1.0 / min_stretch**2) if min_stretch else None
+    system = _System(conn, fr, free, seam, seam_index)
+    chosen = "arap" if energy == "auto" else energy
+    main = {"arap": Arap, "hybrid": Hybrid, "symmetric-dirichlet": SymmetricDirichlet}[chosen](fr)
+    converged = False
+    # "auto" from a far start: a first, looser ARAP run tells whether ARAP crushes
+    # triangles (then the hybrid goes on from there) before it is run to the end.
+    probe = energy == "auto" and barrier > 0
+    mu = barrier
+    while True:
+        run = _Minimiser(_Objective(main, InverseTerm(fr), guard, seam), system, faces, conn.loops, free,
+                         tolerance=tolerance * (_PROBE if probe else 1.0), floor=floor,
+                         length_tolerance=length_tolerance, progress=progress, offset=iterations,
+                         total=max_iterations)
+        uv, used, converged = run(uv, mu if chosen == "arap" else 0.0, max_iterations - iterations)
+        iterations += used
+        if energy != "auto" or chosen != "arap" or iterations >= max_iterations:
+            break
+        if _crushed(fr, uv):
+            chosen, main, probe = "hybrid", Hybrid(fr), False
+        elif probe:
+            probe, mu = False, 0.0  # not crushed: ARAP to the full tolerance, from there
+        else:
+            break
     uv.setflags(write=False)
-    return Relaxation(uv, iterations + used, converged)
+    return Relaxation(uv, iterations, converged, _length_error(seam, uv), chosen)
 
 
-class _StressBarrier:
-    """Edge stress plus ``mu`` times a collapse barrier, and its gradient.
+def _crushed(fr, uv) -> bool:
+    """True when a triangle of ``uv`` is squeezed below ``_CRUSHED`` of its size in some direction."""
+    jac = fr.jacobian(uv)
+    det2, norm2 = jac.det ** 2, jac.norm2
+    smin2 = 2.0 * det2 / (norm2 + np.sqrt(np.maximum(norm2 * norm2 - 4.0 * det2, 0.0)))
+    return bool(smin2.min() < _CRUSHED**2)
 
-    ``E(u) = sum_e (|u_i - u_j| / l_e - 1)**2 + mu * sum_t w_t |J_t^-1|_F**2``
-    with ``J_t`` the triangle's 2x2 Jacobian from its 3D frame to the plane and
-    ``w_t`` its 3D area over the mean area, times 0.75 (the barrier term of a
-    mesh then counts about as many terms as the stress, half as many as edges).
-    ``|J^-1|_F**2 = |J|_F**2 / det(J)**2`` is 2 for a rigid motion and grows
-    without bound as the triangle collapses.
 
-    The two terms are evaluated apart (:meth:`parts`) so that a change of
-    ``mu`` needs no new evaluation.  Coordinates are gathered column by column
-    (several times faster than gathering ``(k, 2)`` rows) and gradients
-    scattered by sparse products.
+def _isometric(fr, uv, floor) -> bool:
+    """True when every triangle of ``uv`` is its 3D triangle moved rigidly, to round-off."""
+    out = Arap(fr).terms(fr.jacobian(uv))  # the value only: no gradient scattered
+    return out[0] <= floor
+
+
+def is_isometric(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, local=None) -> bool:
+    """True when the layout ``uv`` ``(n, 2)`` has no strain: ARAP energy at round-off level (RMS strain 1e-10).
+
+    What :func:`relax` checks first; an exact development needs no relaxation.
+    """
+    return _isometric(frames(vertices, faces, local=local), uv, 1e-20 * len(faces))
+
+
+def _seam_term(n, conn, fr, lengths):
+    """The :class:`EdgeLengths` term of ``relax(lengths=...)`` and its edges' rows in ``conn.edges``, or None, None."""
+    if lengths is None or not len(lengths[0]):
+        return None, None
+    edges, target = lengths[:2]
+    groups = lengths[2] if len(lengths) > 2 else None
+    edges = np.sort(np.asarray(edges, dtype=np.int64), axis=1)
+    index = _edge_index(conn.edges, edges)
+    faces_of = conn.edge_faces[index]
+    side = np.where(faces_of[:, 0] >= 0, faces_of[:, 0], faces_of[:, 1])
+    group = np.arange(len(edges)) if groups is None else np.unique(np.asarray(groups), return_inverse=True)[1]
+    weight = np.bincount(group, fr.weight[side])
+    return EdgeLengths(n, edges, np.asarray(target, dtype=np.float64), group, weight, _SEAM_RHO), index
+
+
+def _edge_rows(table: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Row of each ``edges`` pair (sorted ends) in the unique edge ``table`` (sorted ends), -1 where absent."""
+    n = int(max(table.max(), edges.max())) + 1
+    keys = table[:, 0] * n + table[:, 1]
+    order = np.argsort(keys, kind="stable")
+    want = edges[:, 0] * n + edges[:, 1]
+    pos = np.minimum(np.searchsorted(keys, want, sorter=order), len(keys) - 1)
+    return np.where(keys[order[pos]] == want, order[pos], -1)
+
+
+def _edge_index(table: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """:func:`_edge_rows`, every pair required; InputError naming the first that is not an edge."""
+    rows = _edge_rows(table, edges)
+    if np.any(rows < 0):
+        bad = edges[np.flatnonzero(rows < 0)[0]]
+        raise InputError(f"held length on ({int(bad[0])}, {int(bad[1])}), which is not an edge of the mesh")
+    return rows
+
+
+def _length_error(seam, uv) -> float:
+    return 0.0 if seam is None else float(np.abs(seam.residual(uv)).max())
+
+
+class _Objective:
+    """The relaxation's energy in two parts, ``(E + G + S, B)``, so that a change of ``mu`` needs no evaluation.
+
+    ``E`` the distortion, ``G`` the guard, ``S`` the seam term, ``B`` the
+    barrier; the triangle terms' derivatives are summed before one scatter.
     """
 
-    def __init__(self, vertices, faces, edges, length, *, local=None, min_stretch=None):
-        n = len(vertices)
-        # |J^-1|^2 = 1/s1^2 + 1/s2^2 of a triangle squeezed to min_stretch one way, kept the other.
-        self.floor = 0.0 if not min_stretch else 1.0 + 1.0 / min_stretch**2
-        self.faces, self.edges, self.length = faces, edges, length
-        self._e0, self._e1 = np.ascontiguousarray(edges[:, 0]), np.ascontiguousarray(edges[:, 1])
-        self._f0, self._f1, self._f2 = (np.ascontiguousarray(faces[:, k]) for k in range(3))
-        z = local_coordinates(vertices, faces) if local is None else local
-        r1, r2 = z[:, 1] - z[:, 0], z[:, 2] - z[:, 0]
-        # R = [[r1.x, r2.x], [r1.y, r2.y]]; G = R^-1 R^-T (symmetric).
-        det_r = r1.real * r2.imag - r2.real * r1.imag
-        i11, i12, i21, i22 = r2.imag / det_r, -r2.real / det_r, -r1.imag / det_r, r1.real / det_r
-        self.g11, self.g12, self.g22 = i11 * i11 + i12 * i12, i11 * i21 + i12 * i22, i21 * i21 + i22 * i22
-        self.det_r2 = det_r * det_r
-        area = 0.5 * np.abs(det_r)
-        self.w = 0.75 * area / area.mean()
-        ne, m = len(edges), len(faces)
-        self._inv_length = 1.0 / length
-        # Sparse scatter matrices: per-edge and per-triangle-column gradients to vertices.
-        self.edge_scatter = sp.csr_matrix((np.r_[np.ones(ne), -np.ones(ne)],
-                                           (np.r_[self._e1, self._e0], np.r_[np.arange(ne), np.arange(ne)])),
-                                          shape=(n, ne))
-        cols = np.arange(2 * m)
-        self.face_scatter = sp.csr_matrix(
-            (np.r_[np.ones(2 * m), -np.ones(2 * m)],
-             (np.r_[self._f1, self._f2, self._f0, self._f0], np.r_[cols, cols])), shape=(n, 2 * m))
-
-    def _jacobian(self, u):
-        """Per-triangle ``(P columns a, b, c, d; det P; P G entries; |J|^2)`` of the flat map."""
-        x, y = u[:, 0], u[:, 1]
-        x0, y0 = x.take(self._f0), y.take(self._f0)
-        a, b = x.take(self._f1) - x0, x.take(self._f2) - x0  # P = [[a, b], [c, d]]
-        c, dd = y.take(self._f1) - y0, y.take(self._f2) - y0
-        det_p = a * dd - b * c
-        pg11, pg12 = a * self.g11 + b * self.g12, a * self.g12 + b * self.g22
-        pg21, pg22 = c * self.g11 + dd * self.g12, c * self.g12 + dd * self.g22
-        norm_j = a * pg11 + b * pg12 + c * pg21 + dd * pg22  # |J|^2 (times nothing: G carries R)
-        return a, b, c, dd, det_p, (pg11, pg12, pg21, pg22), norm_j
-
-    def barrier_stiffness(self, u, mu):
-        """Per-triangle curvature scale of the barrier term, ``(m,)``: ``mu w 6 / sigma_min**4``."""
-        *_, det_p, _, norm_j = self._jacobian(u)
-        det2 = det_p * det_p / self.det_r2  # det(J)**2
-        # Smallest singular value squared, in the cancellation-free form
-        # det**2 / (largest one squared).
-        smin2 = 2.0 * det2 / (norm_j + np.sqrt(np.maximum(norm_j * norm_j - 4.0 * det2, 0.0)))
-        with np.errstate(divide="ignore", over="ignore"):
-            return np.minimum(mu * self.w * 6.0 / (smin2 * smin2), 1e12)
-
-    def stress(self, u):
-        """``(S, gradient (n, 2))``: the summed squared edge strain."""
-        x, y = u[:, 0], u[:, 1]
-        dx = x.take(self._e1) - x.take(self._e0)
-        dy = y.take(self._e1) - y.take(self._e0)
-        dl = np.sqrt(dx * dx + dy * dy)
-        r = dl * self._inv_length - 1.0
-        k = 2.0 * r * self._inv_length / np.maximum(dl, 1e-300)
-        return float(r @ r), self.edge_scatter @ np.column_stack([k * dx, k * dy])
-
-    def barrier(self, u):
-        """``(B, gradient (n, 2))`` of the barrier (``mu = 1``); ``(inf, None)`` if a triangle is folded."""
-        return self._inverse_term(u, 0.0)
-
-    def guard(self, u):
-        """``(sum_t w_t max(0, |J_t^-1|^2 - floor)**2, gradient (n, 2))``; ``(inf, None)`` if folded.
-
-        Zero on every triangle squeezed less than ``min_stretch`` allows.
-        """
-        return self._inverse_term(u, self.floor)
-
-    def _inverse_term(self, u, floor):
-        """The barrier (``floor == 0``) or the guard, with its gradient."""
-        a, b, c, dd, det_p, (pg11, pg12, pg21, pg22), norm_j = self._jacobian(u)
-        if not np.all(det_p > 0):
-            return np.inf, None
-        s = self.det_r2 / (det_p * det_p)
-        if floor > 0:
-            excess = np.maximum(norm_j * s - floor, 0.0)  # |J^-1|^2 beyond the floor
-            value = float(self.w @ (excess * excess))
-            ws = 2.0 * self.w * excess * s
-        else:
-            ws = self.w * s
-            value = float(ws @ norm_j)
-        k1 = 2.0 * ws
-        k2 = k1 * norm_j / det_p
-        # d/dP of |J|^2 det_r^2 / det_p^2 = 2 P G s - 2 |J|^2 s / det_p * cof(P),
-        # cof(P) = [[dd, -c], [-b, a]].
-        gx = np.concatenate([k1 * pg11 - k2 * dd, k1 * pg12 + k2 * c])
-        gy = np.concatenate([k1 * pg21 + k2 * b, k1 * pg22 - k2 * a])
-        return value, self.face_scatter @ np.column_stack([gx, gy])
+    def __init__(self, main, barrier, guard, seam):
+        self.main, self.barrier, self.guard, self.seam = main, barrier, guard, seam
+        self.fr = main.fr
 
     def parts(self, u, mu):
-        """``(S, grad S, B, grad B)``; B is 0 (gradient None) when ``mu == 0``, inf when folded.
+        """``(F, grad F, B, grad B)`` with ``F = E + G + S``; ``B`` is 0 (gradient None) when ``mu == 0``.
 
-        ``S`` includes the guard against crushed triangles when ``min_stretch`` was given.
+        ``F`` is inf (gradient None) where a term that sees folds sees one, ``B`` likewise.
         """
-        value, grad = self.stress(u)
-        if self.floor:
-            g_value, g_grad = self.guard(u)
-            if g_grad is None:
-                return np.inf, None, np.inf, None
-            value, grad = value + g_value, grad + g_grad
+        jac = self.fr.jacobian(u)
+        out = self.main.terms(jac)
+        if out is not None and self.guard is not None:
+            extra = self.guard.terms(jac)
+            out = None if extra is None else (out[0] + extra[0], tuple(x + y for x, y in zip(out[1], extra[1])))
+        if out is None:
+            return np.inf, None, np.inf, None
+        value, grad = out[0], self.fr.gradient(*out[1])
+        if self.seam is not None:
+            s_value, s_grad = self.seam(u)
+            value, grad = value + s_value, grad + s_grad
         if mu == 0:
             return value, grad, 0.0, None
-        b_value, b_grad = self.barrier(u)
+        b_value, b_grad = self.barrier(u, jac)
         return value, grad, b_value, b_grad
 
-    def __call__(self, u, mu):
-        """``(E, gradient (n, 2))``; ``(inf, None)`` if ``mu > 0`` and a triangle is folded."""
-        value, grad, b_value, b_grad = self.parts(u, mu)
-        if mu == 0:
-            return value, grad
-        if b_grad is None:
-            return np.inf, None
-        return value + mu * b_value, grad + mu * b_grad
 
+class _System:
+    """The preconditioner ``K``: the energy's curvature as a weighted Laplacian, factorised.
 
-def _quasi_newton(energy, faces, loops, uv, free, lu, *, refactor, barrier, max_iterations, tolerance, floor,
-                  progress, offset, total):
-    """L-BFGS with a Laplacian ``H0`` and a flip-free, non-crossing line search.
-
-    ``H0 = A^-1 / 2`` with ``A`` the stress Laplacian (plus the barrier's
-    curvature while the barrier is on, refreshed every ``_REFRESH``
-    iterations), scaled by the latest ``s.y / y.H0 y``.  ``H0`` is applied to
-    each accepted gradient once and kept, so that the two-loop recursion needs
-    no further solve.  The memory is dropped only when ``H0`` changes.
-    Returns ``(uv, iterations, converged)``.
+    ``K = 2 L(s) + S`` on the free vertices (plus a small anchor at vertex 0
+    when nothing is pinned: the energies do not see translations): ``2 L`` is
+    the Hessian of ``sum_t W_t |J_t|^2``, ``L(s)`` the cotangent Laplacian
+    with each triangle scaled by ``s_t`` (1 for ARAP at an isometry;
+    ``1 + 3 / sigma_min**4`` for the symmetric Dirichlet energy, 4 at an
+    isometry) and ``S`` the seam term's stiffness along the held edges.  The plain matrix (``s = 1``) is factorised once in
+    single precision by SuperLU (it only shapes the steps); stiffened ones
+    are refactorised numerically only by qdldl.
     """
-    size = _size(uv)
-    mu = float(barrier)
-    everywhere = bool(free.all())
 
-    def restrict(g):
-        return g if everywhere else g[free]
+    def __init__(self, conn, fr, free, seam, seam_index):
+        self.conn, self.fr, self.free = conn, fr, free
+        self.extra = np.zeros(len(conn.edges))
+        if seam is not None:
+            np.add.at(self.extra, seam_index, seam.edge_weights())
+        weight = self.weights(None)
+        self.anchor = float(np.abs(weight).mean()) if free.all() else 0.0
+        # The mesh comes in nested-dissection order (patterns.flatten.numbering): factorised as it is.
+        matrix = _laplacian(len(free), conn.edges, weight, anchor=self.anchor)
+        self.plain = factorize(matrix if free.all() else matrix[free][:, free], single=True)
+        self._stiff = None
 
-    def evaluate(u):
-        """``(E, grad E on the free vertices, S, grad S, B, grad B)``; E is inf when folded."""
-        s_value, s_grad, b_value, b_grad = energy.parts(u, mu)
-        if s_grad is None:  # folded (seen by the guard)
-            return np.inf, None, s_value, s_grad, b_value, b_grad
+    def weights(self, scale) -> np.ndarray:
+        """Edge weights ``(e,)`` of ``K`` for triangle scales ``scale`` ``(m,)`` (None: all 1)."""
+        coef = self.fr.dirichlet_weights(scale) * 2.0
+        return np.bincount(self.conn.face_edges.ravel(), coef.ravel(), len(self.conn.edges)) + self.extra
+
+    def stiffened(self, stiffness: np.ndarray):
+        """``K`` with triangle scales ``1 + stiffness``, factorised; the plain factor when that changes little."""
+        if np.mean(stiffness > 1.0) < 0.1:
+            # At most doubling the curvature of under a tenth of the triangles
+            # (a few squeezed ones): not worth a factorisation.
+            return self.plain
+        if self._stiff is None:
+            self._stiff = _StiffLaplacian(self.conn.edges, self.free, anchor=self.anchor)
+        return self._stiff.factorize(self.weights(1.0 + stiffness))
+
+
+class _Memory:
+    """L-BFGS pairs with their preconditioned ``H0 y``, and the two-loop recursion."""
+
+    def __init__(self):
+        self.pairs = []
+
+    def clear(self):
+        self.pairs = []
+
+    def add(self, s, y, hy):
+        if dot(s, y) > 0:
+            self.pairs.append((s, y, hy))
+            del self.pairs[:-_MEMORY]
+
+    def direction(self, grad, hgrad) -> np.ndarray:
+        """``H grad`` by the two-loop recursion; ``H0`` products come precomputed (``hgrad``, ``H0 y``)."""
+        alphas = []
+        for s, y, _ in reversed(self.pairs):
+            alphas.append(dot(s, grad) / dot(y, s))
+            grad = grad - alphas[-1] * y
+        r = hgrad.copy()  # H0 q = H0 g - sum a_i H0 y_i (H0 is linear)
+        for (_, _, hy), a in zip(reversed(self.pairs), alphas):
+            r -= a * hy
+        if self.pairs:
+            s, y, hy = self.pairs[-1]
+            r *= dot(s, y) / dot(y, hy)
+        for (s, y, _), a in zip(self.pairs, reversed(alphas)):
+            r += (a - dot(y, r) / dot(y, s)) * s
+        return r
+
+
+class _Minimiser:
+    """L-BFGS with the :class:`_System` as ``H0`` and a flip-free, non-crossing line search, in stages.
+
+    Stages: the barrier weight ``mu`` is cut tenfold each time progress stalls,
+    then dropped; in the last stage (``mu = 0``), each time progress stalls
+    the seam multipliers are updated until the held lengths are reached.
+    ``H0`` is applied to each accepted gradient once and kept, so that the
+    two-loop recursion needs no further solve; the memory is dropped only when
+    ``H0`` changes.
+    """
+
+    def __init__(self, objective, system, faces, loops, free, *, tolerance, floor, length_tolerance, progress,
+                 offset, total):
+        self.objective, self.system, self.faces, self.loops, self.free = objective, system, faces, loops, free
+        self.tolerance, self.floor, self.length_tolerance = tolerance, floor, length_tolerance
+        self.progress, self.offset, self.total = progress, offset, total
+        self.everywhere = bool(free.all())
+        self.sd = not isinstance(objective.main, Arap)  # a barrier itself: its matrix follows the squeeze
+        self.size = None  # the layout's size, for the smallest useful step (set at the start)
+
+    def restrict(self, g):
+        return g if self.everywhere else g[self.free]
+
+    def evaluate(self, u, mu):
+        """``(value, gradient on the free vertices, parts)``; value inf where folded."""
+        parts = self.objective.parts(u, mu)
+        f_value, f_grad, b_value, b_grad = parts
+        if f_grad is None or (mu > 0 and b_grad is None):
+            return np.inf, None, parts
         if mu == 0:
-            return s_value, restrict(s_grad), s_value, s_grad, b_value, b_grad
-        if b_grad is None:
-            return np.inf, None, s_value, s_grad, b_value, b_grad
-        return s_value + mu * b_value, restrict(s_grad + mu * b_grad), s_value, s_grad, b_value, b_grad
+            return f_value, self.restrict(f_grad), parts
+        return f_value + mu * b_value, self.restrict(f_grad + mu * b_grad), parts
 
-    value, grad, *terms = evaluate(uv)
-    base = lu
-    since_refresh = _REFRESH  # refresh at once if the barrier is on
-    history = []  # (s, y, H0 y)
-    recent = [value]
-    iterations = 0
-    converged = False
-    hgrad = None
-    while iterations < max_iterations:
-        iterations += 1
-        if mu > 0 and since_refresh >= _REFRESH:
-            fresh, since_refresh = refactor(uv, mu), 0
-            if fresh is not lu:
-                lu, hgrad, history = fresh, None, []
-        since_refresh += 1
-        if hgrad is None:
-            hgrad = 0.5 * lu.solve(grad)
+    def reweigh(self, parts, mu):
+        """``(value, gradient)`` from :meth:`evaluate`'s parts with another barrier weight."""
+        f_value, f_grad, b_value, b_grad = parts
+        if mu == 0:
+            return f_value, self.restrict(f_grad)
+        return f_value + mu * b_value, self.restrict(f_grad + mu * b_grad)
+
+    def factor(self, u, mu):
+        """The preconditioner for the current stage at ``u``."""
+        if self.sd:
+            return self.system.stiffened(self.objective.barrier.stiffness(u))
+        if mu > 0:
+            return self.system.stiffened(mu * self.objective.barrier.stiffness(u))
+        return self.system.plain
+
+    def __call__(self, uv, barrier, max_iterations):
+        """Run; returns ``(uv, iterations, converged)``."""
+        mu = float(barrier)
+        self.size = _size(uv)
+        value, grad, parts = self.evaluate(uv, mu)
+        lu, hgrad, memory = self.factor(uv, mu), None, _Memory()
+        since_refresh, recent, rounds = 0, [value], 0
+        stiff = self.sd or mu > 0
+        iterations = 0
+        while iterations < max_iterations:
+            iterations += 1
+            if stiff and since_refresh >= _REFRESH:
+                fresh, since_refresh = self.factor(uv, mu), 0
+                if fresh is not lu:
+                    lu, hgrad = fresh, None
+                    memory.clear()
+            since_refresh += 1
+            if hgrad is None:
+                hgrad = lu.solve(grad)
+            moved, step = self.line_search(uv, value, grad, hgrad, memory, mu)
+            if moved:
+                cand, new_value, new_grad, new_parts = step
+                new_hgrad = lu.solve(new_grad)
+                memory.add(self.restrict(cand - uv), new_grad - grad, new_hgrad - hgrad)
+                uv, value, grad, hgrad, parts = cand, new_value, new_grad, new_hgrad, new_parts
+            if self.progress is not None:
+                self.progress(self.offset + iterations, self.total)
+            if not moved and memory.pairs:
+                memory.clear()  # retry once from the plain preconditioned gradient
+                continue
+            recent.append(value)
+            gain = recent[0] - value if len(recent) > _WINDOW else np.inf
+            del recent[:-_WINDOW - 1]
+            last = mu == 0.0
+            scale = max(abs(value), self.floor)
+            stalled = not moved or gain <= _WINDOW * self.tolerance * (1.0 if last else _STAGE_TOLERANCE) * scale
+            if not stalled and not (last and value <= self.floor):
+                continue
+            if last:
+                seam = self.objective.seam
+                if seam is None or rounds >= _SEAM_ROUNDS or seam.update(uv) <= self.length_tolerance:
+                    return uv, iterations, seam is None or _length_error(seam, uv) <= self.length_tolerance
+                rounds += 1
+                value, grad, parts = self.evaluate(uv, mu)  # new multipliers: a new energy
+            else:
+                mu = mu * _DROP if mu > _WEAKEST * 1.5 else 0.0
+                stiff = self.sd or mu > 0
+                value, grad = self.reweigh(parts, mu)  # the terms are at hand
+            lu, hgrad, since_refresh, recent = self.factor(uv, mu), None, 0, [value]
+            memory.clear()
+        return uv, iterations, False
+
+    def line_search(self, uv, value, grad, hgrad, memory, mu):
+        """``(moved, (uv, value, grad, parts))`` along the L-BFGS direction, flip-free and non-crossing."""
         direction = np.zeros_like(uv)
-        direction[free] = -_two_loop(grad, hgrad, history)
-        slope = _dot(grad, restrict(direction))
+        direction[self.free] = -memory.direction(grad, hgrad)
+        slope = dot(grad, self.restrict(direction))
         if not slope < 0:  # stale memory: fall back to the preconditioned gradient
-            history = []
-            direction[free] = -hgrad
-            slope = _dot(grad, restrict(direction))
-        step = min(1.0, 0.9 * float(flip_free_steps(faces, uv, direction, horizon=1.0 / 0.9).min()))
+            memory.clear()
+            direction[self.free] = -hgrad
+            slope = dot(grad, self.restrict(direction))
+        step = min(1.0, 0.9 * float(flip_free_steps(self.faces, uv, direction, horizon=1.0 / 0.9,
+                                                     corners=self.objective.fr.corners).min()))
         # Steps below round-off of the layout's size make no progress.
-        smallest = 1e-13 * size / max(float(np.abs(direction).max()), 1e-300)
-        moved = False
+        smallest = 1e-13 * self.size / max(float(np.abs(direction).max()), 1e-300)
         while step > smallest:
             cand = uv + step * direction
-            new_value, new_grad, *new_terms = evaluate(cand)
-            if new_value <= value + 1e-4 * step * slope and _boundary_crossings(cand, loops) is None:
-                moved = True
-                break
+            new_value, new_grad, parts = self.evaluate(cand, mu)
+            if new_value <= value + 1e-4 * step * slope and _boundary_crossings(cand, self.loops) is None:
+                return True, (cand, new_value, new_grad, parts)
             step *= 0.5
-        if moved:
-            new_hgrad = 0.5 * lu.solve(new_grad)
-            s, y = restrict(cand - uv), new_grad - grad
-            if _dot(s, y) > 0:
-                history.append((s, y, new_hgrad - hgrad))
-                del history[:-_MEMORY]
-            uv, value, grad, hgrad, terms = cand, new_value, new_grad, new_hgrad, new_terms
-        if progress is not None:
-            progress(offset + iterations, total)
-        if not moved and history:
-            history = []  # retry once from the plain preconditioned gradient
-            continue
-        last = mu == 0.0
-        # Progress is judged over a window of iterations: single quasi-Newton
-        # steps vary too much (a short step is often followed by a long one).
-        recent.append(value)
-        gain = recent[0] - value if len(recent) > _WINDOW else np.inf
-        del recent[:-_WINDOW - 1]
-        stalled = not moved or gain <= _WINDOW * tolerance * (1.0 if last else _STAGE_TOLERANCE) * value
-        if last and (stalled or value <= floor):
-            converged = True
-            break
-        if stalled:  # next stage: a tenth of the barrier, or none; the terms are at hand
-            mu = mu * _DROP if mu > _WEAKEST * 1.5 else 0.0
-            s_value, s_grad, b_value, b_grad = terms
-            value = s_value + mu * b_value
-            grad = restrict(s_grad + mu * b_grad) if mu > 0 else restrict(s_grad)
-            fresh, since_refresh = (refactor(uv, mu) if mu > 0 else base), 0
-            lu, history, hgrad, recent = fresh, [], None, [value]
-    return uv, iterations, converged
+        return False, None
 
 
-def _dot(a: np.ndarray, b: np.ndarray) -> float:
-    """Sum of the elementwise product of two arrays of one shape, without a temporary."""
-    return float(np.vdot(a, b))
-
-
-def _two_loop(grad, hgrad, history):
-    """L-BFGS two-loop recursion; ``H0`` products come precomputed (``hgrad``, ``H0 y``)."""
-    alphas = []
-    for s, y, _ in reversed(history):
-        alphas.append(_dot(s, grad) / _dot(y, s))
-        grad = grad - alphas[-1] * y
-    # H0 q = H0 g - sum a_i H0 y_i (H0 is linear).
-    r = hgrad.copy()
-    for (_, _, hy), a in zip(reversed(history), alphas):
-        r -= a * hy
-    if history:
-        s, y, hy = history[-1]
-        r *= _dot(s, y) / _dot(y, hy)
-    for (s, y, _), a in zip(history, reversed(alphas)):
-        b = _dot(y, r) / _dot(y, s)
-        r += (a - b) * s
-    return r
-
-
-def _travel_to_pins(faces, loops, e, length, weight, laplacian, free, uv, pin_index, pin_target,
-                    max_iterations, progress):
+def _travel_to_pins(faces, loops, e, length, free, uv, pin_index, pin_target, max_iterations, progress):
     """Move the pins onto their targets by stress-majorization steps, staying one-to-one.
 
-    Each step aims at the minimiser of the stress's majorizer with the pins at
-    their targets (one solve with the Laplacian's free block), cut vertex by
-    vertex so nothing folds or crosses.  Returns ``(uv, iterations)``.
+    Each step aims at the minimiser of the edge stress's majorizer with the
+    pins at their targets (one solve with the graph Laplacian's free block,
+    weights ``1 / l**2``), cut vertex by vertex so nothing folds or crosses.
+    Returns ``(uv, iterations)``.
     """
     n = len(uv)
+    weight = 1.0 / length**2
+    laplacian = _laplacian(n, e, weight)
     lu = factorize(laplacian[free][:, free])
     coupling = laplacian[free][:, ~free]
     size = _size(uv)
@@ -528,8 +584,9 @@ def _travel_to_pins(faces, loops, e, length, weight, laplacian, free, uv, pin_in
         for k in range(2):
             rhs[:, k] = np.bincount(e[:, 1], q[:, k], n) - np.bincount(e[:, 0], q[:, k], n)
         target = np.empty((n, 2))
-        target[~free] = pin_target
-        target[free] = lu.solve(rhs[free] - coupling @ pin_target)
+        target[pin_index] = pin_target
+        # The pinned block in vertex order (``~free`` is sorted; ``pin_index`` need not be).
+        target[free] = lu.solve(rhs[free] - coupling @ target[~free])
         moved = _safe_move(faces, loops, uv, target)
         if progress is not None:
             progress(iterations, max_iterations)
@@ -620,6 +677,41 @@ def _boundary_crossings(uv: np.ndarray, loops):
         return None
     _, pair, i, j = crossing_segments(uv, loops)
     return np.unique(np.concatenate([pair[i].ravel(), pair[j].ravel()]))
+
+
+def check_lengths(lengths, conn: Connectivity, name: str, *, numbering=None):
+    """Validate ``lengths = (edges, targets[, groups])``; returns ``(int64 (k, 2), float64 (k,)[, int64 (k,)])``.
+
+    Every pair must be an edge of the mesh and every target a positive finite length.
+    ``numbering`` ``(n,) int64``, if given, renumbers the vertices (input vertex ``j`` is vertex
+    ``numbering[j]`` of ``conn``); the edges come back renumbered, messages name the input's.
+    """
+    try:
+        edges, targets, *rest = lengths
+        edges = np.asarray(edges)
+        targets = np.asarray(targets, dtype=np.float64)
+        groups = np.asarray(rest[0]) if rest else None
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: lengths must be (edges (k, 2), lengths (k,)[, groups (k,)])") from None
+    if len(rest) > 1 or (groups is not None and (groups.shape != targets.shape
+                                                 or not np.issubdtype(groups.dtype, np.integer))):
+        raise InputError(f"{name}: lengths must be (edges (k, 2), lengths (k,)[, integer groups (k,)])")
+    if edges.ndim != 2 or edges.shape[1:] != (2,) or targets.shape != (len(edges),):
+        raise InputError(f"{name}: lengths must be (edges (k, 2), lengths (k,)), got shapes {edges.shape} and "
+                         f"{targets.shape}")
+    if len(edges) and (not np.issubdtype(edges.dtype, np.integer) or edges.min() < 0
+                       or edges.max() >= conn.n_vertices):
+        raise InputError(f"{name}: held edges must be vertex indices in [0, {conn.n_vertices})")
+    if not np.all(np.isfinite(targets) & (targets > 0)):
+        raise InputError(f"{name}: held lengths must be positive finite numbers")
+    edges = edges.astype(np.int64)
+    inner = edges if numbering is None else numbering[edges]
+    index = _edge_rows(conn.edges, np.sort(inner, axis=1))
+    if np.any(index < 0):
+        bad = edges[np.flatnonzero(index < 0)[0]]
+        raise InputError(f"{name}: held length on ({int(bad[0])}, {int(bad[1])}), which is not an edge of the mesh")
+    edges = inner
+    return (edges, targets) if groups is None else (edges, targets, groups.astype(np.int64))
 
 
 def check_pins(pins, n: int, name: str):
