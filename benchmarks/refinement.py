@@ -25,8 +25,9 @@ Triangulations, each at about 1k, 10k and 100k faces (``--sizes``)
   90 degrees about x, so that the sphere's seam meridian and poles lie outside
   the cap (the face is a plain disk).  The cup is ``bd.Sphere(1)`` scaled to the
   ellipsoid (a B-spline) and split at z = 0; its face keeps the sphere's seam
-  meridian and pole, so the mesher's result is slit from the rim to the pole
-  and the two sides of the slit are welded back here (a disk again).  The
+  meridian and pole.  ``patterns.load`` sews a freeform face along its own seam
+  line (it slit such faces from the rim to the pole before); any closing seam
+  left is welded here, so every triangulation is one disk.  The
   saddle is the bilinear Bezier patch that is exactly the hyperbolic paraboloid,
   intersected with a cylinder of radius 200 mm.
 * ``grid``: cap: a geodesic icosphere (every icosahedron face divided into
@@ -66,9 +67,10 @@ Printed criteria
   ``trimesh.creation.icosphere(subdivisions=6, radius=500)`` sliced and
   ``trimesh.creation.uv_sphere(radius=500, count=[180, 180])`` sliced: max / min
   <= 1.15 and within 10 % of the lowest; with the old edge-strain RMS on the same
-  meshes.  One more row, not judged: the cap as the mesher gives it from the
-  unturned ``bd.Sphere(500)``, slit along the sphere's seam meridian to the
-  pole (a different surface to flatten: the slit opens).
+  meshes.  One more row, judged too: the cap as the mesher gives it from the
+  unturned ``bd.Sphere(500)``, whose seam meridian runs to the pole (sewn by
+  ``patterns.load``; it slit the cap there before, which is how the issue's
+  0.94 % came about).
 """
 
 from __future__ import annotations
@@ -97,7 +99,7 @@ SHAPES = ("cap", "cup", "saddle")
 TRIANGULATIONS = ("cad", "grid", "fan")
 LABELS = {
     "cap": {"cad": "CAD mesher", "grid": "icosphere, sliced", "fan": "UV sphere, sliced"},
-    "cup": {"cad": "CAD mesher (slit welded)", "grid": "square grid, cut", "fan": "polar grid (fan)"},
+    "cup": {"cad": "CAD mesher", "grid": "square grid, cut", "fan": "polar grid (fan)"},
     "saddle": {"cad": "CAD mesher", "grid": "square grid, cut", "fan": "polar grid (fan)"},
 }
 """What each triangulation is, per surface."""
@@ -426,7 +428,8 @@ def issue_cap_meshes():
         ("CAD mesher, patterns.load(face) defaults", *mesher, True),
         ("icosphere(subdivisions=6) sliced", *slice_cap(ico.vertices, ico.faces), True),
         ("uv_sphere(count=[180, 180]) sliced", *slice_cap(uv.vertices, uv.faces), True),
-        ("CAD mesher, unturned sphere: slit to the pole", np.asarray(slit.vertices), np.asarray(slit.faces), False),
+        ("CAD mesher, unturned sphere (seam meridian sewn)", np.asarray(slit.vertices), np.asarray(slit.faces),
+         True),
     ]
 
 
@@ -568,7 +571,7 @@ def issue_cap_text(results: list[tuple[Case, str, bool]], markdown: bool) -> tup
                 "lowest": None if worst is None else worst <= ACCEPT_LOWEST}
     bullet = "* " if markdown else ""
     lines = [bench.format_table(header, rows, markdown), "",
-             f"{bullet}principal-strain RMS, max / min over the three judged meshes: {bench._number(spread, '.3f')} "
+             f"{bullet}principal-strain RMS, max / min over the judged meshes: {bench._number(spread, '.3f')} "
              f"(criterion <= {ACCEPT_SPREAD}): {_verdict(verdicts['spread'])}",
              f"{bullet}the old edge-strain RMS on the same meshes, max / min: {bench._number(edge_spread, '.3f')}",
              f"{bullet}lowest strain RMS of any method: "

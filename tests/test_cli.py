@@ -328,3 +328,23 @@ def test_energy_and_min_stretch_options(tmp_path):
     assert not (tmp_path / "bad.dxf").exists()
 
 
+
+
+def test_seams_and_ease_from_the_command_line(tmp_path):
+    lengths = {}
+    for label, extra in (("true", ()), ("free", ("--seams", "free")), ("eased", ("--ease", "0:face0:5"))):
+        report = tmp_path / f"{label}.json"
+        proc = run("flatten", SAMPLES / "cup.step", "-o", tmp_path / f"{label}.dxf", "--report", report, *extra)
+        assert proc.returncode == 0, proc.stderr
+        lengths[label] = json.loads(report.read_text())["seams"][0]
+    true, free, eased = lengths["true"], lengths["free"], lengths["eased"]
+    assert true["length_flat"] == pytest.approx([true["length_3d_polyline"]] * 2, rel=2e-4)
+    assert free["length_held"] is None and min(free["length_flat"]) > 1.03 * free["length_3d"]
+    side = eased["panels"].index("face0")
+    assert eased["length_flat"][side] == pytest.approx(eased["length_3d_polyline"] + 5.0, rel=2e-4)
+    for bad, words in ((("--ease", "junk"), "SEAM:PANEL"), (("--seams", "loose"), "invalid choice"),
+                       (("--ease", "9:face0:5"), "seam 9")):
+        out = tmp_path / "bad.dxf"
+        proc = run("flatten", SAMPLES / "cup.step", "-o", out, *bad)
+        assert proc.returncode == 2 and words in proc.stderr and "Traceback" not in proc.stderr
+        assert not out.exists()

@@ -11,10 +11,9 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-
-from ..check import Overlap, overlap_verdict
 from threadpoolctl import threadpool_limits
 
+from ..check import Overlap, overlap_verdict
 from ..errors import FlattenError, InputError, PatternsError
 from ..measure import Distortion, distortion, local_coordinates, signed_areas
 from ..mesh import _readonly, as_mesh_arrays, unique_edges, unique_ints, validate_mesh

@@ -98,7 +98,7 @@ class Frames:
     scatter: sp.csc_matrix
     corners: tuple
 
-    def jacobian(self, u: np.ndarray) -> "Jacobian":
+    def jacobian(self, u: np.ndarray) -> Jacobian:
         """The :class:`Jacobian` of every triangle for the layout ``u`` ``(n, 2)``."""
         x, y = u[:, 0], u[:, 1]
         f0, f1, f2 = self.corners

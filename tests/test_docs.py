@@ -1,0 +1,106 @@
+"""Every code block of README.md and docs/*.md runs, so the documentation cannot go stale.
+
+Python blocks of one file run in order in one namespace, in a fresh folder where
+``samples/`` is the repository's.  Shell blocks run their ``patterns`` commands
+with this interpreter's entry point and must exit 0 (or the code a ``# exit N``
+comment gives).  JSON blocks must parse.  A block that cannot run in a test
+says so in the markdown, on the line just before its fence::
+
+    <!-- test: skip (needs a Dask scheduler) -->
+
+and is reported as skipped with that reason.  ``<!-- test: slow -->`` marks a
+long block with the ``slow`` marker.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+FILES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+_FENCE = re.compile(r"^```(\w*)\s*$")
+_MARK = re.compile(r"^<!--\s*test:\s*(skip|slow)\s*(?:\((.*)\))?\s*-->\s*$")
+
+
+def _blocks(path: Path):
+    """``(line, language, code, mark, reason)`` of every fenced block of a markdown file."""
+    lines = path.read_text(encoding="utf-8").splitlines()
+    out, i = [], 0
+    while i < len(lines):
+        m = _FENCE.match(lines[i])
+        if not m:
+            i += 1
+            continue
+        start, lang = i + 1, m.group(1).lower()
+        j = i + 1
+        while j < len(lines) and not lines[j].startswith("```"):
+            j += 1
+        mark = _MARK.match(lines[i - 1]) if i > 0 else None
+        out.append((start, lang, "\n".join(lines[i + 1:j]), mark and mark.group(1), mark and mark.group(2)))
+        i = j + 1
+    return out
+
+
+def _cases():
+    for path in FILES:
+        for line, lang, code, mark, reason in _blocks(path):
+            marks = [pytest.mark.slow] if mark == "slow" else []
+            if mark == "skip":
+                marks.append(pytest.mark.skip(reason=reason or "marked skip in the markdown"))
+            yield pytest.param(path, line, lang, code, id=f"{path.relative_to(REPO)}:{line}", marks=marks)
+
+
+@pytest.fixture(scope="module")
+def workdirs(tmp_path_factory):
+    """One working folder and one namespace per markdown file."""
+    made = {}
+
+    def get(path):
+        if path not in made:
+            folder = tmp_path_factory.mktemp(path.stem)
+            (folder / "samples").symlink_to(REPO / "samples")
+            made[path] = (folder, {"__name__": "__docs__"})
+        return made[path]
+
+    return get
+
+
+def _patterns_command() -> list[str]:
+    return [sys.executable, "-m", "patterns"]
+
+
+@pytest.mark.parametrize(("path", "line", "lang", "code"), list(_cases()))
+def test_code_block_runs(path, line, lang, code, workdirs):
+    folder, namespace = workdirs(path)
+    if lang == "python":
+        old = Path.cwd()
+        os.chdir(folder)
+        try:
+            exec(compile(code, f"{path.name}:{line}", "exec"), namespace)  # noqa: S102 - the docs' own code
+        finally:
+            os.chdir(old)
+    elif lang in ("bash", "sh", "console", "shell", ""):
+        commands = [c for c in (x.strip() for x in code.splitlines()) if c and not c.startswith("#")]
+        commands = [c.removeprefix("$ ") for c in commands]
+        runnable = [c for c in commands if c.split()[0] in ("patterns", ".venv/bin/patterns")]
+        if not runnable:
+            pytest.skip("no patterns command in this block (output shown, or set-up commands)")
+        for command in runnable:
+            text, _, comment = command.partition("#")
+            want = int(m.group(1)) if (m := re.search(r"exit (?:code )?(\d)", comment)) else 0
+            argv = _patterns_command() + shlex.split(text)[1:]
+            proc = subprocess.run(argv, cwd=folder, capture_output=True, text=True, timeout=600)
+            assert proc.returncode == want, f"{command}: exit {proc.returncode}\n{proc.stderr}"
+            assert "Traceback" not in proc.stderr
+    elif lang == "json":
+        json.loads(code)
+    else:
+        pytest.skip(f"a {lang} block")
