@@ -12,7 +12,7 @@ The public API, all importable from the top level::
     result.overlap.one_to_one, result.distortion.strain_rms
 """
 
-from .check import Finding, Overlap, Report, check, overlap_verdict
+from .check import Code, Finding, PanelReport, Report, SeamReport, Severity, check
 from .cut import Cut, cut_to_disk
 from .errors import (
     CadError,
@@ -31,8 +31,9 @@ from .layout import Layout, layout
 from .load import load, read_cad, read_mesh
 from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
-from .model import Model, Panel, Seam
+from .model import Model, Panel, Seam, Surface, SurfaceKind
 from .pattern import FlatPanel, FlatSeam, Pattern
+from .predicates import Overlap, overlap_verdict
 from .tessellate import mesh_shape, tessellate_face
 
 __version__ = "0.1.0"
@@ -41,6 +42,7 @@ __all__ = [
     "ENERGIES",
     "METHODS",
     "CadError",
+    "Code",
     "Connectivity",
     "Cut",
     "Distortion",
@@ -58,12 +60,17 @@ __all__ = [
     "Model",
     "Overlap",
     "Panel",
+    "PanelReport",
     "Pattern",
     "PatternsError",
     "Report",
     "Seam",
     "SeamLengths",
+    "SeamReport",
+    "Severity",
     "StrainStats",
+    "Surface",
+    "SurfaceKind",
     "__version__",
     "check",
     "cut_to_disk",

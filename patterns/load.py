@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import CadError, InputError
-from .mesh import as_mesh_arrays, unique_ints, validate_mesh
+from .mesh import as_mesh_arrays, drop_unused, unique_ints, validate_mesh
 
 __all__ = ["CAD_SUFFIXES", "MESH_SUFFIXES", "MeshFile", "drop_unused", "load", "mesh_model", "read_cad", "read_mesh", "weld"]
 
@@ -102,22 +102,6 @@ def _unique_rows(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     inverse = np.empty(len(points), dtype=np.int64)
     inverse[order] = np.cumsum(starts) - 1
     return order[starts], inverse  # lexsort is stable: each group's first row is its lowest index
-
-
-def drop_unused(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-    """Remove vertices that no face uses, keeping the order of the others.
-
-    Returns
-    -------
-    vertices : (k, 3) float64
-    faces : (m, 3) int64
-        Re-indexed.
-    n_unused : int
-    """
-    used = np.zeros(len(vertices), dtype=bool)
-    used[faces.ravel()] = True
-    remap = np.cumsum(used) - 1
-    return vertices[used], remap[faces], int((~used).sum())
 
 
 def _existing_file(path, suffixes, kind: str) -> tuple[Path, str]:

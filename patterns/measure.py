@@ -37,6 +37,7 @@ __all__ = [
     "boundary_lengths",
     "distortion",
     "edge_strain",
+    "flat_direction",
     "folded_faces",
     "local_coordinates",
     "no_strain",
@@ -436,3 +437,38 @@ def strain_stats(strains: TriangleStrain) -> StrainStats:
     worst = int(np.argmax(mag))
     return StrainStats(rms, weighted_percentile(mag, w, 95.0), weighted_percentile(mag, w, 99.0),
                        float(mag[worst]), worst)
+
+
+def flat_direction(vertices, faces, uv, direction) -> np.ndarray:
+    """Where a 3D direction points in a flattening: the area-weighted mean of its images.
+
+    On each triangle the direction is projected onto the triangle's plane and
+    carried to the plane by the triangle's own linear map.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    uv : (n, 2) float64
+    direction : (3,) float64
+        Any length.
+
+    Returns
+    -------
+    (2,) float64
+        Unit vector in the plane (``(0, 1)`` if the direction has no image).
+    """
+    p, q = vertices[faces], uv[faces]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    f1, f2 = q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]
+    # Solve direction ~ a e1 + b e2 (least squares on the triangle's plane): Gram system.
+    g11, g12, g22 = (e1 * e1).sum(1), (e1 * e2).sum(1), (e2 * e2).sum(1)
+    r1, r2 = e1 @ direction, e2 @ direction
+    det = g11 * g22 - g12 * g12
+    a = (g22 * r1 - g12 * r2) / det
+    b = (g11 * r2 - g12 * r1) / det
+    images = a[:, None] * f1 + b[:, None] * f2
+    area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
+    total = (images * area[:, None]).sum(axis=0)
+    norm = np.linalg.norm(total)
+    return total / norm if norm > 0 else np.array([0.0, 1.0])

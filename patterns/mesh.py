@@ -27,6 +27,7 @@ __all__ = [
     "as_mesh_arrays",
     "boundary_loops",
     "check_boundary_vertices",
+    "drop_unused",
     "edge_lengths",
     "edge_tables",
     "face_areas",
@@ -473,3 +474,19 @@ def boundary_loops(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, 
         direction; the longest loop (by vertex count) first.
     """
     return validate_mesh(vertices, faces, name=name)[2].loops
+
+
+def drop_unused(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """Remove vertices that no face uses, keeping the order of the others.
+
+    Returns
+    -------
+    vertices : (k, 3) float64
+    faces : (m, 3) int64
+        Re-indexed.
+    n_unused : int
+    """
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces.ravel()] = True
+    remap = np.cumsum(used) - 1
+    return vertices[used], remap[faces], int((~used).sum())

@@ -12,7 +12,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .measure import TriangleStrain, no_strain, triangle_strains
+from .measure import TriangleStrain, flat_direction, no_strain, triangle_strains
 
 __all__ = ["FlatPanel", "FlatSeam", "Pattern"]
 
@@ -88,8 +88,6 @@ class FlatPanel:
         size = float(np.ptp(uv, axis=0).max()) * 4 + 1.0
         lines = []
         if surface.kind is SurfaceKind.CYLINDER:
-            from .flatten import flat_direction
-
             along = flat_direction(self.vertices, self.faces, uv, surface.axis)  # the rulings' direction
             across = np.array([along[1], -along[0]])
             w = uv @ across

@@ -12,8 +12,7 @@ from scipy.sparse import csgraph
 
 from .cut import cut_to_disk
 from .errors import CadError, InputError
-from .load import drop_unused
-from .mesh import face_areas, unique_ints, validate_mesh
+from .mesh import drop_unused, face_areas, unique_ints, validate_mesh
 
 __all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
 

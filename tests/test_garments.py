@@ -11,7 +11,7 @@ import patterns
 from patterns import surfaces  # noqa: F401  (patterns.surfaces below)
 from patterns.errors import InputError
 from patterns.export.dxf import notch_positions
-from patterns.flatten import flat_direction
+from patterns.measure import flat_direction
 from patterns.samples import cup, duct_transition, hopper, hull_panel
 
 from .conftest import SAMPLES

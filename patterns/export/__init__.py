@@ -1,6 +1,6 @@
 """Writing results: DXF cutting patterns, flat meshes, heat maps, always atomically."""
 
-from ._atomic import atomic_output
+from ..files import atomic_output
 from .dxf import write_outline_dxf, write_pattern_dxf
 from .heatmap import heat_map
 from .mesh import write_flat_obj

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import InputError
-from ._atomic import atomic_output
+from ..files import atomic_output
 
 __all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "PROFILES", "UNITS", "seam_label",
            "write_outline_dxf", "write_pattern_dxf"]

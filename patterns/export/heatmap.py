@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ._atomic import atomic_output
+from ..files import atomic_output
 
 __all__ = ["HEAT_MAP_FORMATS", "display_offsets", "heat_map"]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._atomic import atomic_output
+from ..files import atomic_output
 
 __all__ = ["write_flat_obj"]
 

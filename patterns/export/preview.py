@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import InputError
-from ._atomic import atomic_output
+from ..files import atomic_output
 
 __all__ = ["PREVIEW_FORMATS", "preview_dxf"]
 

@@ -13,10 +13,10 @@ from functools import cached_property
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from ..check import Overlap, overlap_verdict
 from ..errors import FlattenError, InputError, PatternsError
-from ..measure import Distortion, distortion, local_coordinates, signed_areas
+from ..measure import Distortion, distortion, flat_direction, local_coordinates, signed_areas
 from ..mesh import _readonly, as_mesh_arrays, unique_edges, unique_ints, validate_mesh
+from ..predicates import Overlap, overlap_verdict
 from . import grow
 from .embed import lscm, tutte_embedding
 from .energy import ENERGIES
@@ -594,28 +594,6 @@ def _grain_table(grain, model) -> dict:
             raise InputError(f"{model.name}: a grain is a non-zero 3D direction, got {direction!r}")
         out[name] = d / np.linalg.norm(d)
     return out
-
-
-def flat_direction(vertices, faces, uv, direction) -> np.ndarray:
-    """Where a 3D direction points in a flattening: the area-weighted mean of its images, (2,) unit.
-
-    On each triangle the direction is projected onto the triangle's plane and
-    carried to the plane by the triangle's own linear map.
-    """
-    p, q = vertices[faces], uv[faces]
-    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    f1, f2 = q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]
-    # Solve direction ~ a e1 + b e2 (least squares on the triangle's plane): Gram system.
-    g11, g12, g22 = (e1 * e1).sum(1), (e1 * e2).sum(1), (e2 * e2).sum(1)
-    r1, r2 = e1 @ direction, e2 @ direction
-    det = g11 * g22 - g12 * g12
-    a = (g22 * r1 - g12 * r2) / det
-    b = (g11 * r2 - g12 * r1) / det
-    images = a[:, None] * f1 + b[:, None] * f2
-    area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
-    total = (images * area[:, None]).sum(axis=0)
-    norm = np.linalg.norm(total)
-    return total / norm if norm > 0 else np.array([0.0, 1.0])
 
 
 def _turn_to_grain(result: Flattening, direction) -> Flattening:

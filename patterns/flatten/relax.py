@@ -44,10 +44,10 @@ import numpy as np
 import scipy.sparse as sp
 import shapely
 
-from ..check import crossing_segments
 from ..errors import InputError
 from ..measure import signed_areas
 from ..mesh import Connectivity, edge_lengths
+from ..predicates import crossing_segments
 from .embed import LDL, LDLFactor, factorize
 from .energy import ENERGIES, Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, dot, frames
 

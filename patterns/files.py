@@ -7,7 +7,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from ..errors import ExportError
+from .errors import ExportError
 
 __all__ = ["atomic_output"]
 
