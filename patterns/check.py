@@ -16,6 +16,7 @@ from .errors import InputError
 from .files import atomic_output
 from .measure import edge_strain, folded_faces, strain_stats
 from .mesh import _readonly
+from .options import check_number
 from .pattern import Pattern
 from .predicates import Overlap, boundary_crossings, crossing_segments, overlap_verdict
 
@@ -262,10 +263,11 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
     """
     if not isinstance(pattern, Pattern):
         raise InputError(f"check() takes a patterns.Pattern (from patterns.flatten), got {type(pattern).__name__}")
-    for label, value in (("max_strain", max_strain), ("max_seam_mismatch", max_seam_mismatch)):
-        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
-                                  or not np.isfinite(value) or value <= 0):
-            raise InputError(f"{pattern.name}: {label} must be a positive number, got {value!r}")
+    if max_strain is not None:
+        max_strain = check_number(max_strain, "max_strain", low=0, low_open=True, name=pattern.name)
+    if max_seam_mismatch is not None:
+        max_seam_mismatch = check_number(max_seam_mismatch, "max_seam_mismatch", low=0, low_open=True,
+                                         name=pattern.name)
     findings = []
     panel_reports = []
     for flat in pattern.panels:

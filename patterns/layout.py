@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError, LayoutError
+from .options import check_number
 
 __all__ = ["Layout", "LayoutError", "layout"]
 
@@ -96,11 +97,9 @@ def layout(pattern, *, width: float, gap: float = 10.0, margin: float = 0.0, all
 
     if not isinstance(pattern, Pattern):
         raise InputError(f"layout() takes a patterns.Pattern, got {type(pattern).__name__}")
-    for label, value, low in (("width", width, 0.0), ("gap", gap, -1.0), ("margin", margin, -1.0)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= low \
-                or value < 0:
-            raise InputError(f"{pattern.name}: {label} must be a number {'> 0' if low == 0 else '>= 0'} mm, "
-                             f"got {value!r}")
+    width = check_number(width, "width (mm)", low=0, low_open=True, name=pattern.name)
+    gap = check_number(gap, "gap (mm)", low=0, name=pattern.name)
+    margin = check_number(margin, "margin (mm)", low=0, name=pattern.name)
     step = float(step) if step is not None else width / 150.0
     if not step > 0:
         raise InputError(f"{pattern.name}: step must be a positive number of mm, got {step!r}")

@@ -12,9 +12,22 @@ from enum import Enum
 
 import numpy as np
 
-from .mesh import _readonly, face_areas
+from .mesh import face_areas
 
 __all__ = ["Model", "Panel", "Seam", "Surface", "SurfaceKind"]
+
+
+def _own(array, dtype=None) -> np.ndarray:
+    """A read-only array the record owns: the caller's array itself only if it is already read-only.
+
+    A constructor never freezes (nor keeps a writeable reference to) an array it was given.
+    """
+    a = np.asarray(array, dtype=dtype)
+    base = a.base if isinstance(a.base, np.ndarray) else None
+    if a.flags.writeable or (base is not None and base.flags.writeable):
+        a = a.copy()  # a view of a writeable array could still change under the record
+    a.setflags(write=False)
+    return a
 
 
 class SurfaceKind(str, Enum):
@@ -91,11 +104,11 @@ class Panel:
     param: np.ndarray | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "vertices", _readonly(self.vertices))
-        object.__setattr__(self, "faces", _readonly(self.faces))
-        object.__setattr__(self, "loops", tuple(_readonly(loop) for loop in self.loops))
+        object.__setattr__(self, "vertices", _own(self.vertices))
+        object.__setattr__(self, "faces", _own(self.faces))
+        object.__setattr__(self, "loops", tuple(_own(loop) for loop in self.loops))
         if self.param is not None:
-            object.__setattr__(self, "param", _readonly(np.array(self.param, dtype=np.float64)))
+            object.__setattr__(self, "param", _own(self.param, np.float64))
 
     @property
     def area(self) -> float:
@@ -135,8 +148,8 @@ class Seam:
     cad_edge: int | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "points", _readonly(self.points))
-        object.__setattr__(self, "vertices", tuple(_readonly(v) for v in self.vertices))
+        object.__setattr__(self, "points", _own(self.points))
+        object.__setattr__(self, "vertices", tuple(_own(v) for v in self.vertices))
 
     @property
     def polyline_length(self) -> float:

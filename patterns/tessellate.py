@@ -13,6 +13,7 @@ from scipy.sparse import csgraph
 from .cut import cut_to_disk
 from .errors import CadError, InputError
 from .mesh import drop_unused, face_areas, unique_ints, validate_mesh
+from .options import check_number
 
 __all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
 
@@ -134,12 +135,10 @@ def mesh_shape(shape, *, max_edge: float | None = None, tolerance: float = 0.05,
     wrapped = shape.wrapped if hasattr(shape, "wrapped") else shape
     if not isinstance(wrapped, TopoDS_Shape) or wrapped.IsNull():
         raise InputError(f"{name}: expected a build123d shape or an OCP TopoDS_Shape, got {type(shape).__name__}")
-    for label, value in (("tolerance", tolerance), ("angular_tolerance", angular_tolerance)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
-            raise InputError(f"{name}: {label} must be a positive number, got {value!r}")
-    if max_edge is not None and (isinstance(max_edge, bool) or not isinstance(max_edge, (int, float))
-                                 or not np.isfinite(max_edge) or max_edge <= 0):
-        raise InputError(f"{name}: max_edge must be a positive number of mm, got {max_edge!r}")
+    tolerance = check_number(tolerance, "tolerance", low=0, low_open=True, name=name)
+    angular_tolerance = check_number(angular_tolerance, "angular_tolerance", low=0, low_open=True, name=name)
+    if max_edge is not None:
+        max_edge = check_number(max_edge, "max_edge (mm)", low=0, low_open=True, name=name)
     if sew:
         wrapped = _sewn(wrapped, tolerance)
     mesher = _ShapeMesher(wrapped, name=name)

@@ -324,3 +324,20 @@ def test_loose_faces_are_sewn_into_seams():
     for seam in model.seams:
         for side in (0, 1):
             np.testing.assert_array_equal(model.panels[seam.panels[side]].vertices[seam.vertices[side]], seam.points)
+
+
+def test_constructors_never_freeze_the_callers_arrays():
+    """A Panel or Seam owns read-only copies; the arrays it was given stay writeable and
+    later writes to them do not reach the model."""
+    from patterns import surfaces
+
+    v, f = surfaces.spherical_cap(radius=100.0, half_angle=30.0, n_faces=200)
+    loops = patterns.mesh.boundary_loops(v, f)
+    panel = patterns.Panel("p", v, f, loops)
+    assert v.flags.writeable and f.flags.writeable
+    assert not panel.vertices.flags.writeable and not panel.faces.flags.writeable
+    v[0] += 1000.0
+    assert not np.allclose(panel.vertices[0], v[0])
+    points = v[loops[0][:3]].copy()
+    seam = patterns.Seam(0, (0, 0), points, (loops[0][:3], loops[0][:3]), 1.0)
+    assert points.flags.writeable and not seam.points.flags.writeable

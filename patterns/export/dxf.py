@@ -12,6 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import InputError
+from ..options import check_number, is_number
 from ..files import atomic_output
 
 __all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "PROFILES", "UNITS", "seam_label",
@@ -235,10 +236,8 @@ def _snap(loop: np.ndarray, tol: float = 1e-6) -> np.ndarray:
 
 def _allowance_lookup(seam_allowance, seam_ids, path):
     """A function ``seam id or None -> allowance, mm`` from a number or a mapping."""
-    if isinstance(seam_allowance, (int, float)) and not isinstance(seam_allowance, bool):
-        value = float(seam_allowance)
-        if not np.isfinite(value) or value < 0:
-            raise InputError(f"{path}: seam_allowance must be a number >= 0 mm, got {seam_allowance!r}")
+    if is_number(seam_allowance):
+        value = check_number(seam_allowance, "seam_allowance (mm)", low=0, name=str(path))
         return lambda seam: value
     if hasattr(seam_allowance, "items"):
         table = {}
@@ -246,9 +245,7 @@ def _allowance_lookup(seam_allowance, seam_ids, path):
             if key is not None and key not in seam_ids:
                 raise InputError(f"{path}: seam_allowance names seam {key!r}, which the pattern does not have "
                                  f"(seams {sorted(seam_ids)}; None for every other edge)")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
-                raise InputError(f"{path}: seam_allowance[{key!r}] must be a number >= 0 mm, got {value!r}")
-            table[key] = float(value)
+            table[key] = check_number(value, f"seam_allowance[{key!r}] (mm)", low=0, name=str(path))
         default = table.get(None, 0.0)
         return lambda seam: table.get(seam, default)
     raise InputError(f"{path}: seam_allowance must be a number (mm) or a mapping of seam ids to mm, "
@@ -378,16 +375,11 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
     version = version or "R2000"
     if version not in MACHINE_VERSIONS:
         raise InputError(f"{path}: unknown DXF version {version!r}; choose one of {', '.join(MACHINE_VERSIONS)}")
-    if text_height is not None and not (isinstance(text_height, (int, float)) and text_height > 0):
-        raise InputError(f"{path}: text_height must be a positive number of mm, got {text_height!r}")
-    if not isinstance(arc_tolerance, (int, float)) or isinstance(arc_tolerance, bool) or not arc_tolerance > 0:
-        raise InputError(f"{path}: arc_tolerance must be a positive number of mm, got {arc_tolerance!r}")
-    if bend_spacing is not None and (isinstance(bend_spacing, bool) or not isinstance(bend_spacing, (int, float))
-                                     or not bend_spacing > 0):
-        raise InputError(f"{path}: bend_spacing must be a positive number of mm, got {bend_spacing!r}")
-    if notch_spacing is not None and (isinstance(notch_spacing, bool) or not isinstance(notch_spacing, (int, float))
-                                      or not notch_spacing > 0):
-        raise InputError(f"{path}: notch_spacing must be a positive number of mm, got {notch_spacing!r}")
+    check_number(arc_tolerance, "arc_tolerance (mm)", low=0, low_open=True, name=str(path))
+    for option, value in (("text_height", text_height), ("bend_spacing", bend_spacing),
+                          ("notch_spacing", notch_spacing)):
+        if value is not None:
+            check_number(value, f"{option} (mm)", low=0, low_open=True, name=str(path))
     if seam_corners not in ("mitre", "square"):
         raise InputError(f"{path}: seam_corners must be 'mitre' or 'square', got {seam_corners!r}")
     if notch_style not in NOTCH_STYLES:

@@ -16,6 +16,7 @@ from threadpoolctl import threadpool_limits
 from ..errors import FlattenError, InputError, PatternsError
 from ..measure import Distortion, distortion, flat_direction, local_coordinates, signed_areas
 from ..mesh import _readonly, as_mesh_arrays, unique_edges, unique_ints, validate_mesh
+from ..options import check_number, is_number
 from ..predicates import Overlap, overlap_verdict
 from . import grow
 from .embed import lscm, tutte_embedding
@@ -194,20 +195,16 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
     if min_stretch is not None:
         if method != "relaxed":
             raise InputError(f"{name}: min_stretch applies to method='relaxed' only")
-        if isinstance(min_stretch, bool) or not isinstance(min_stretch, (int, float, np.floating)) \
-                or not 0 < min_stretch < 1:
-            raise InputError(f"{name}: min_stretch must be a number between 0 and 1, got {min_stretch!r}")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) or max_iterations < 1:
-        raise InputError(f"{name}: max_iterations must be a positive integer, got {max_iterations!r}")
-    if not (isinstance(tolerance, (int, float, np.floating)) and tolerance >= 0):
-        raise InputError(f"{name}: tolerance must be a number >= 0, got {tolerance!r}")
+        min_stretch = check_number(min_stretch, "min_stretch", low=0, high=1, low_open=True, high_open=True,
+                                   name=name)
+    max_iterations = check_number(max_iterations, "max_iterations", low=0, low_open=True, integer=True, name=name)
+    tolerance = check_number(tolerance, "tolerance", low=0, name=name)
     if energy not in ENERGIES:
         raise InputError(f"{name}: unknown energy {energy!r}; choose one of {', '.join(ENERGIES)}")
     if method != "relaxed" and (lengths is not None or energy != "auto"):
         raise InputError(f"{name}: {'lengths' if lengths is not None else 'energy'} applies to method='relaxed' only")
     v, f, num, conn = _working_mesh(vertices, faces, name)
-    if seed_face is not None and (isinstance(seed_face, bool) or not isinstance(seed_face, (int, np.integer))
-                                  or not 0 <= seed_face < len(f)):
+    if seed_face is not None and not (is_number(seed_face, integer=True) and 0 <= seed_face < len(f)):
         raise InputError(f"{name}: seed_face must be a face index in [0, {len(f)}), got {seed_face!r}")
     # The engine works in the working numbering: options that name vertices or faces follow it.
     inv = None if num is None else num.vertex_inverse
@@ -413,11 +410,9 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
     eased = validate_ease(ease, model)
     if eased and (mode is SeamLengths.FREE or method != "relaxed"):
         raise InputError(f"{model.name}: ease needs seams='true' or 'total' and method='relaxed'")
-    if max_strain is not None and (isinstance(max_strain, bool) or not isinstance(max_strain, (int, float))
-                                   or not np.isfinite(max_strain) or max_strain <= 0):
-        raise InputError(f"{model.name}: max_strain must be a positive number, got {max_strain!r}")
-    if isinstance(max_darts, bool) or not isinstance(max_darts, (int, np.integer)) or max_darts < 0:
-        raise InputError(f"{model.name}: max_darts must be an integer >= 0, got {max_darts!r}")
+    if max_strain is not None:
+        max_strain = check_number(max_strain, "max_strain", low=0, low_open=True, name=model.name)
+    max_darts = check_number(max_darts, "max_darts", low=0, integer=True, name=model.name)
     eased_panels = {model.seams[s].panels[side] for s, side in eased}
     flat, targets = [], {}
     for i, panel in enumerate(model.panels):

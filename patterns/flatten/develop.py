@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..model import SurfaceKind
+from ..options import check_number
 
 __all__ = ["REFERENCES", "develop", "neutral_offset", "offset_points"]
 
@@ -46,11 +47,8 @@ def neutral_offset(thickness: float, k_factor: float, reference: str, *, name: s
         The skin the model shows: the inside of the bends, the outside, or the
         middle of the sheet.
     """
-    if isinstance(thickness, bool) or not isinstance(thickness, (int, float)) or not np.isfinite(thickness) \
-            or thickness < 0:
-        raise InputError(f"{name}: thickness must be a number >= 0 mm, got {thickness!r}")
-    if isinstance(k_factor, bool) or not isinstance(k_factor, (int, float)) or not 0 <= k_factor <= 1:
-        raise InputError(f"{name}: k_factor must be a number in [0, 1], got {k_factor!r}")
+    thickness = check_number(thickness, "thickness (mm)", low=0, name=name)
+    k_factor = check_number(k_factor, "k_factor", low=0, high=1, name=name)
     if reference not in REFERENCES:
         raise InputError(f"{name}: reference must be one of {', '.join(REFERENCES)}, got {reference!r}")
     inside = {"inside": 0.0, "outside": -thickness, "mid": -0.5 * thickness}[reference]

@@ -25,6 +25,7 @@ from enum import Enum
 import numpy as np
 
 from ..errors import InputError
+from ..options import check_number, is_number
 
 __all__ = ["Ease", "SeamLengths", "held_lengths", "seam_edges", "seam_mode", "validate_ease"]
 
@@ -87,7 +88,7 @@ def validate_ease(ease, model) -> dict:
     for item in ease:
         if not isinstance(item, Ease):
             raise InputError(f"{model.name}: ease takes patterns.Ease values, got {type(item).__name__}")
-        if not (isinstance(item.seam, (int, np.integer)) and 0 <= item.seam < len(model.seams)):
+        if not (is_number(item.seam, integer=True) and 0 <= item.seam < len(model.seams)):
             raise InputError(f"{model.name}: ease names seam {item.seam!r}; the model has seams 0..{len(model.seams) - 1}")
         seam = model.seams[item.seam]
         names = [model.panels[p].name for p in seam.panels]
@@ -95,8 +96,7 @@ def validate_ease(ease, model) -> dict:
             raise InputError(f"{model.name}: ease on seam {item.seam} names panel {item.panel!r}; "
                              f"the seam joins {names[0]!r} and {names[1]!r}")
         for label, x in (("mm", item.mm), ("ratio", item.ratio)):
-            if isinstance(x, bool) or not isinstance(x, (int, float, np.floating)) or not np.isfinite(x):
-                raise InputError(f"{model.name}: ease {label} must be a finite number, got {x!r}")
+            check_number(x, f"ease {label}", name=model.name)
         length = seam.polyline_length
         factor = 1.0 + float(item.ratio) + float(item.mm) / length
         if not 0.5 <= factor <= 2.0:
