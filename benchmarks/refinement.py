@@ -91,6 +91,8 @@ import trimesh  # noqa: E402
 from scipy.spatial import Delaunay  # noqa: E402
 
 import patterns  # noqa: E402
+from patterns import mesh  # noqa: E402
+from patterns.mesh import corner_angles  # noqa: E402
 
 SIZES = {"1k": 1_000, "10k": 10_000, "100k": 100_000}
 """Target face counts, by label."""
@@ -131,11 +133,9 @@ CAD_TOLERANCES = {"tolerance": 10.0, "angular_tolerance": 1.0}
 
 
 def drop_unused(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Keep the vertices some face uses; renumber the faces (order kept, nothing welded)."""
-    used = np.unique(faces)
-    remap = np.full(len(vertices), -1, dtype=np.int64)
-    remap[used] = np.arange(len(used))
-    return np.ascontiguousarray(vertices[used], dtype=np.float64), remap[faces]
+    """Keep the vertices some face uses (:func:`patterns.mesh.drop_unused`: order kept, nothing welded)."""
+    v, f, _ = mesh.drop_unused(np.asarray(vertices, dtype=np.float64), faces)
+    return np.ascontiguousarray(v), f
 
 
 def slice_cap(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -147,14 +147,7 @@ def slice_cap(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.n
 
 def min_angle(vertices: np.ndarray, faces: np.ndarray) -> float:
     """The smallest interior angle of any triangle, degrees."""
-    p = vertices[faces]
-    angles = []
-    for k in range(3):
-        a = p[:, (k + 1) % 3] - p[:, k]
-        b = p[:, (k + 2) % 3] - p[:, k]
-        cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-        angles.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
-    return float(np.min(angles))
+    return float(np.degrees(corner_angles(vertices, faces).min()))
 
 
 def orient_up(points: np.ndarray, faces: np.ndarray) -> np.ndarray:

@@ -33,17 +33,15 @@ from patterns.flatten.embed import lscm, tutte_embedding
 from patterns.flatten.seams import SeamLengths, held_lengths
 from patterns.measure import strain_rms
 from patterns.mesh import unique_edges, validate_mesh
+from patterns.samples import bowl_segment, sphere_gores
 
 relax = importlib.import_module("patterns.flatten.relax")
 
 
 def models():
     """``(name, model, panel index)``: one freeform panel of each model."""
-    sys.path.insert(0, str(REPO / "benchmarks"))
-    from seams import bowl, gores  # the parts of benchmarks/seams.py (and of the tests)
-
     out = [("cup", patterns.load(REPO / "samples" / "cup.step"))]
-    out += [("bowl segment", patterns.load(bowl())), ("sphere gores", patterns.load(gores()))]
+    out += [("bowl segment", patterns.load(bowl_segment())), ("sphere gores", patterns.load(sphere_gores()))]
     return [(name, m, next(i for i, p in enumerate(m.panels) if p.surface is None)) for name, m in out]
 
 

@@ -10,7 +10,7 @@ Run from the repository root::
 Models (``patterns.load``, default meshing unless ``--max-edge``)
 -----------------------------------------------------------------
 * ``cup``: ``samples/cup.step``: four freeform gores of a cup, four seams.
-* ``bowl``: a 90-degree segment of a bowl, built here in build123d: the spline
+* ``bowl``: a 90-degree segment of a bowl (``patterns.samples.bowl_segment``): the spline
   through (0, 0), (80, 25), (150, 100) (tangents (1, 0) and (0.4, 1)) in the XZ
   plane, closed by the straight lines to (0, 100) and back to (0, 0), revolved
   90 degrees about z.  One freeform face (the revolved spline) meets three
@@ -56,9 +56,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_flatten as bench  # noqa: E402  (format_table, machine_summary)
 
-import build123d as bd  # noqa: E402
-
 import patterns  # noqa: E402
+from patterns.samples import bowl_segment, sphere_gores  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -86,29 +85,9 @@ EXACT = 1e-9
 # --------------------------------------------------------------------------- #
 
 
-def bowl():
-    """A 90-degree segment of a bowl: a spline profile revolved (a freeform face), closed by three planes."""
-    with bd.BuildPart() as part:
-        with bd.BuildSketch(bd.Plane.XZ):
-            with bd.BuildLine():
-                bd.Spline((0, 0), (80, 25), (150, 100), tangents=((1, 0), (0.4, 1)))
-                bd.Line((150, 100), (0, 100))
-                bd.Line((0, 100), (0, 0))
-            bd.make_face()
-        bd.revolve(axis=bd.Axis.Z, revolution_arc=90)
-    return part.part
-
-
-def gores():
-    """A sphere of radius 100 mm split by two planes through its axis: four gores, pole to pole."""
-    halves = bd.Sphere(100).split(bd.Plane.XZ, keep=bd.Keep.BOTH)
-    quarters = [q for h in halves for q in h.split(bd.Plane.YZ, keep=bd.Keep.BOTH)]
-    return bd.Shell([q.faces().filter_by(bd.GeomType.SPHERE)[0] for q in quarters])
-
-
 def models(max_edge: float | None):
     """``(name, patterns.Model)`` of the three models."""
-    sources = {"cup": REPO / "samples" / "cup.step", "bowl": bowl(), "gores": gores()}
+    sources = {"cup": REPO / "samples" / "cup.step", "bowl": bowl_segment(), "gores": sphere_gores()}
     return [(name, patterns.load(source, max_edge=max_edge)) for name, source in sources.items()]
 
 

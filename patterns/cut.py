@@ -23,7 +23,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from .errors import MeshTopologyError
-from .mesh import _readonly, check_boundary_vertices, edge_lengths, edge_tables, trace_loops
+from .mesh import _readonly, check_boundary_vertices, corner_angles, edge_lengths, edge_tables, trace_loops
 
 __all__ = ["Cut", "cut_along", "cut_to_disk", "pieces"]
 
@@ -99,14 +99,7 @@ def loop_turning(vertices: np.ndarray, faces: np.ndarray, loop: np.ndarray) -> f
         Radians: about ``+2 pi`` for the rim of a flat disk, ``-2 pi`` for a
         hole in it, 0 for the end of a straight tube.
     """
-    p = vertices[faces]
-    angle = np.empty(faces.shape)
-    for k in range(3):
-        a = p[:, (k + 1) % 3] - p[:, k]
-        b = p[:, (k + 2) % 3] - p[:, k]
-        cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-        angle[:, k] = np.arccos(np.clip(cos, -1.0, 1.0))
-    total = np.bincount(faces.ravel(), angle.ravel(), len(vertices))
+    total = np.bincount(faces.ravel(), corner_angles(vertices, faces).ravel(), len(vertices))
     return float(np.sum(np.pi - total[loop]))
 
 

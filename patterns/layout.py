@@ -93,9 +93,9 @@ def layout(pattern, *, width: float, gap: float = 10.0, margin: float = 0.0, all
     import shapely
     from shapely import affinity
 
-    from .pattern import Pattern
-
-    if not isinstance(pattern, Pattern):
+    # What a Pattern is, by what layout uses of it (importing the class would make a cycle:
+    # Pattern.layout() calls this function).
+    if not (hasattr(pattern, "panels") and callable(getattr(pattern, "placed", None))):
         raise InputError(f"layout() takes a patterns.Pattern, got {type(pattern).__name__}")
     width = check_number(width, "width (mm)", low=0, low_open=True, name=pattern.name)
     gap = check_number(gap, "gap (mm)", low=0, name=pattern.name)

@@ -261,7 +261,7 @@ def distortion(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, loops
         weights = a3 / a3.sum()
         folded = int(np.count_nonzero(~(sa > 0)))
     return Distortion(
-        strain_rms=float(np.sqrt(0.5 * (weights @ (principal**2).sum(axis=1)))),
+        strain_rms=_principal_rms(principal, a3),
         strain_max=float(principal.max()),
         symmetric_dirichlet=float("inf") if folded else _symmetric_dirichlet(sigma, weights),
         stretch_p1=weighted_percentile(sigma[:, 1], a3, 1.0),
@@ -401,9 +401,12 @@ def strain_rms(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> float
     -------
     float, dimensionless (0.01 = 1 %)
     """
-    sigma = principal_stretches(vertices, faces, uv)
-    a3 = face_areas(vertices, faces)
-    return float(np.sqrt(0.5 * (a3 @ ((sigma - 1.0) ** 2).sum(axis=1)) / a3.sum()))
+    return _principal_rms(principal_stretches(vertices, faces, uv) - 1.0, face_areas(vertices, faces))
+
+
+def _principal_rms(strain: np.ndarray, area: np.ndarray) -> float:
+    """``sqrt(sum_t A_t (e1**2 + e2**2) / (2 sum_t A_t))`` of principal strains ``(m, 2)`` and areas ``(m,)``."""
+    return float(np.sqrt(0.5 * (area @ (strain**2).sum(axis=1)) / area.sum()))
 
 
 @dataclass(frozen=True)
@@ -433,7 +436,7 @@ class StrainStats:
 def strain_stats(strains: TriangleStrain) -> StrainStats:
     """:class:`StrainStats` of a :func:`triangle_strains` result."""
     mag, w = strains.magnitude, strains.area_3d
-    rms = float(np.sqrt(0.5 * (w @ (strains.strain**2).sum(axis=1)) / w.sum()))
+    rms = _principal_rms(strains.strain, w)
     worst = int(np.argmax(mag))
     return StrainStats(rms, weighted_percentile(mag, w, 95.0), weighted_percentile(mag, w, 99.0),
                        float(mag[worst]), worst)

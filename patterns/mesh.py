@@ -27,6 +27,7 @@ __all__ = [
     "as_mesh_arrays",
     "boundary_loops",
     "check_boundary_vertices",
+    "corner_angles",
     "drop_unused",
     "edge_lengths",
     "edge_tables",
@@ -490,3 +491,26 @@ def drop_unused(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np
     used[faces.ravel()] = True
     remap = np.cumsum(used) - 1
     return vertices[used], remap[faces], int((~used).sum())
+
+
+def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Interior angle of every triangle at each of its corners.
+
+    Parameters
+    ----------
+    vertices : (n, 3) or (n, 2) float64
+    faces : (m, 3) int64
+
+    Returns
+    -------
+    (m, 3) float64
+        Radians; column ``k`` is the angle at corner ``k``.
+    """
+    p = vertices[faces]
+    angle = np.empty(faces.shape)
+    for k in range(3):
+        a = p[:, (k + 1) % 3] - p[:, k]
+        b = p[:, (k + 2) % 3] - p[:, k]
+        cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+        angle[:, k] = np.arccos(np.clip(cos, -1.0, 1.0))
+    return angle

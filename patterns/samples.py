@@ -22,6 +22,14 @@ names in ``samples/`` to them (``samples/make_cad.py`` writes those files, and
 * ``rolled_cylinder`` -- a rolled shell, 500 mm across and 500 mm high: one
   cylindrical face closed by its seam line (sheet metal: its blank is a
   rectangle, 2 pi times the neutral radius long).
+
+Two more parts, built here but not bundled as files (the seam tests and
+``benchmarks/seams.py`` use them):
+
+* ``bowl_segment`` -- a 90-degree segment of a bowl: a spline profile revolved
+  (one freeform face, its rim a quarter circle of 150 mm) closed by three planes.
+* ``sphere_gores`` -- a sphere of radius 100 mm split by two planes through its
+  axis: four gores, pole to pole.
 """
 
 from __future__ import annotations
@@ -30,7 +38,8 @@ from math import pi
 
 import numpy as np
 
-__all__ = ["SAMPLES", "cup", "duct_transition", "hopper", "hull_panel", "rolled_cylinder", "square_to_round"]
+__all__ = ["SAMPLES", "bowl_segment", "cup", "duct_transition", "hopper", "hull_panel", "rolled_cylinder",
+           "sphere_gores", "square_to_round"]
 
 
 def duct_transition():
@@ -119,6 +128,30 @@ def rolled_cylinder():
 
     cylinder = Solid.make_cylinder(250.0, 500.0)
     return Shell([f for f in cylinder.faces() if f.geom_type.name == "CYLINDER"])
+
+
+def bowl_segment():
+    """A spline profile revolved 90 degrees about z (a freeform face) and closed by three planes; a solid."""
+    import build123d as bd
+
+    with bd.BuildPart() as part:
+        with bd.BuildSketch(bd.Plane.XZ):
+            with bd.BuildLine():
+                bd.Spline((0, 0), (80, 25), (150, 100), tangents=((1, 0), (0.4, 1)))
+                bd.Line((150, 100), (0, 100))
+                bd.Line((0, 100), (0, 0))
+            bd.make_face()
+        bd.revolve(axis=bd.Axis.Z, revolution_arc=90)
+    return part.part
+
+
+def sphere_gores():
+    """The four spherical faces of a sphere of radius 100 split by the xz and yz planes, as one shell."""
+    import build123d as bd
+
+    halves = bd.Sphere(100).split(bd.Plane.XZ, keep=bd.Keep.BOTH)
+    quarters = [q for h in halves for q in h.split(bd.Plane.YZ, keep=bd.Keep.BOTH)]
+    return bd.Shell([q.faces().filter_by(bd.GeomType.SPHERE)[0] for q in quarters])
 
 
 SAMPLES = {

@@ -679,7 +679,8 @@ class _ShapeMesher:
         # would slit a cap to its pole.  A face that closes into a tube is cut
         # open again below, along a path of its own choosing.  Developable faces
         # keep their seam line: their exact development unrolls them from it.
-        freeform = [surface_of(self.surfaces[k], self.faces[k], self.devs[k]) is None for k in range(len(meshes))]
+        surfaces = [surface_of(self.surfaces[k], self.faces[k], self.devs[k]) for k in range(len(meshes))]
+        freeform = [s is None for s in surfaces]
         rows, cols = [], []
         self_merged = set()
         for e, occ in enumerate(occ_of_edge):
@@ -723,7 +724,7 @@ class _ShapeMesher:
             surface = param = None
             if len(members) == 1:
                 k = members[0]
-                surface = surface_of(self.surfaces[k], self.faces[k], self.devs[k])
+                surface = surfaces[k]
                 if surface is not None:
                     param = meshes[k].param[fv[first[order]] - offsets[k]]
             panels.append(Panel(label, v, f, tuple(loops), tuple(members), surface=surface, param=param))

@@ -1,6 +1,5 @@
 """Seam-true flattening: seams as long flat as in 3D, both sides equal, ease on purpose."""
 
-import build123d as bd
 import numpy as np
 import pytest
 
@@ -8,29 +7,10 @@ import patterns
 from patterns import Ease
 from patterns.check import Code
 from patterns.errors import InputError
+from patterns.samples import bowl_segment, sphere_gores
 
 from .conftest import SAMPLES
 from .helpers import independent_one_to_one
-
-
-def _bowl():
-    """A 90-degree segment of a bowl: a spline profile revolved (a freeform face), closed by three planes."""
-    with bd.BuildPart() as bowl:
-        with bd.BuildSketch(bd.Plane.XZ):
-            with bd.BuildLine():
-                bd.Spline((0, 0), (80, 25), (150, 100), tangents=((1, 0), (0.4, 1)))
-                bd.Line((150, 100), (0, 100))
-                bd.Line((0, 100), (0, 0))
-            bd.make_face()
-        bd.revolve(axis=bd.Axis.Z, revolution_arc=90)
-    return bowl.part
-
-
-def _gores():
-    """A sphere of radius 100 mm split by two planes through its axis: four gores, pole to pole."""
-    halves = bd.Sphere(100).split(bd.Plane.XZ, keep=bd.Keep.BOTH)
-    quarters = [q for h in halves for q in h.split(bd.Plane.YZ, keep=bd.Keep.BOTH)]
-    return bd.Shell([q.faces().filter_by(bd.GeomType.SPHERE)[0] for q in quarters])
 
 
 @pytest.fixture(scope="module")
@@ -74,7 +54,7 @@ def test_cup_seams_are_true_on_both_sides(cup_model):
 def test_a_freeform_panel_against_an_exact_one():
     """The bowl: where the freeform face meets a plane developed exactly, the two sides
     of the seam end equal (free, they differ by 7 mm on the 235.6 mm rim)."""
-    model = patterns.load(_bowl())
+    model = patterns.load(bowl_segment())
     kinds = [p.surface.kind.value if p.surface else "freeform" for p in model.panels]
     assert kinds.count("freeform") == 1 and kinds.count("plane") == 3
     free = patterns.flatten(model, seams="free")
@@ -87,7 +67,7 @@ def test_a_freeform_panel_against_an_exact_one():
 
 
 def test_a_sphere_in_four_gores():
-    model = patterns.load(_gores())
+    model = patterns.load(sphere_gores())
     assert len(model.panels) == 4 and len(model.seams) == 4
     pattern = patterns.flatten(model)
     _assert_seams_true(pattern)
@@ -113,7 +93,7 @@ def test_ease_lengthens_one_side_on_purpose(cup_model, ease, extra):
 
 
 def test_ease_on_a_planar_panel_sends_it_through_the_engine():
-    model = patterns.load(_bowl())
+    model = patterns.load(bowl_segment())
     rim = max(model.seams, key=lambda s: s.length)
     plane = next(model.panels[p].name for p in rim.panels if model.panels[p].surface is not None)
     pattern = patterns.flatten(model, ease=Ease(rim.id, plane, mm=3.0))

@@ -437,20 +437,21 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         if progress is not None:
             progress(i + 1, len(model.panels))
     seams_out = []
+    edges = [unique_edges(fp.faces) for fp in flat]  # once per panel, not per seam side
     for seam in model.seams:
-        lengths = tuple(_flat_length(flat[p].flattening, idx) for p, idx in zip(seam.panels, seam.vertices))
+        lengths = tuple(_flat_length(flat[p].flattening, edges[p], idx) for p, idx in zip(seam.panels, seam.vertices))
         held_at = tuple(targets.get((seam.id, side)) for side in range(2))
         seams_out.append(FlatSeam(seam, lengths, None if None in held_at else held_at))
     return Pattern(model=model, panels=tuple(flat), seams=tuple(seams_out), method=method,
                    thickness=float(thickness), k_factor=float(k_factor), reference=reference)
 
 
-def _flat_length(result: Flattening, idx) -> float:
-    """Flat length of a seam side given by its vertices, segment by segment along the mesh's edges."""
+def _flat_length(result: Flattening, edges: np.ndarray, idx) -> float:
+    """Flat length of a seam side given by its vertices, segment by segment along the mesh's ``edges``."""
     from .seams import seam_edges
 
     idx = np.asarray(idx, dtype=np.int64)
-    pairs = seam_edges(result.vertices, unique_edges(result.faces), np.column_stack([idx[:-1], idx[1:]]))
+    pairs = seam_edges(result.vertices, edges, np.column_stack([idx[:-1], idx[1:]]))
     return float(np.linalg.norm(result.uv[pairs[:, 1]] - result.uv[pairs[:, 0]], axis=1).sum())
 
 

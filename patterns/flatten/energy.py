@@ -45,14 +45,15 @@ threads the machine has.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..measure import local_coordinates
 
-__all__ = ["ENERGIES", "Arap", "EdgeLengths", "Frames", "Hybrid", "InverseTerm", "Jacobian", "SymmetricDirichlet", "dot",
-           "frames"]
+__all__ = ["ENERGIES", "Arap", "EdgeLengths", "Frames", "Hybrid", "InverseTerm", "Jacobian", "SymmetricDirichlet",
+           "dot", "frames"]
 
 
 ENERGIES = ("auto", "arap", "hybrid", "symmetric-dirichlet")
@@ -83,20 +84,32 @@ class Frames:
         ``det R``, twice the 3D area (positive).
     weight : (m,) float64
         ``W_t``: 3D area over the mean triangle area (dimensionless).
-    scatter : (n, 2 m) sparse float64 (CSC)
-        Maps per-triangle derivatives with respect to the columns of ``P``
-        (first the ``m`` derivatives for ``u1 - u0``, then the ``m`` for
-        ``u2 - u0``) to vertex gradients.
     corners : tuple of three (m,) int64
         The faces' corner columns, contiguous (fast gathers).
+    n_vertices : int
     """
 
     faces: np.ndarray
     inverse: tuple
     det_r: np.ndarray
     weight: np.ndarray
-    scatter: sp.csc_matrix
     corners: tuple
+    n_vertices: int
+
+    @cached_property
+    def scatter(self) -> sp.csc_matrix:
+        """``(n, 2 m)`` sparse: per-triangle derivatives with respect to the columns of ``P`` (first the ``m``
+        for ``u1 - u0``, then the ``m`` for ``u2 - u0``) to vertex gradients.  Built on first use: a
+        value-only evaluation (is a start already exact?) needs none."""
+        m = len(self.faces)
+        c0, c1, c2 = self.corners
+        # Column c < m: +1 at corner 1, -1 at corner 0 of face c; column m + c: corner 2 and corner 0.
+        # Two entries a column, built straight in CSC form (no sort).
+        rows = np.empty(4 * m, dtype=np.int64)
+        rows[0:2 * m:2], rows[1:2 * m:2] = c1, c0
+        rows[2 * m::2], rows[2 * m + 1::2] = c2, c0
+        return sp.csc_matrix((np.tile([1.0, -1.0], 2 * m), rows, np.arange(0, 4 * m + 1, 2)),
+                             shape=(self.n_vertices, 2 * m))
 
     def jacobian(self, u: np.ndarray) -> Jacobian:
         """The :class:`Jacobian` of every triangle for the layout ``u`` ``(n, 2)``."""
@@ -165,6 +178,11 @@ class Jacobian:
         m11, m12, m22 = a * a + c * c, a * b + c * d, b * b + d * d
         return m11 * a + m12 * b, m11 * c + m12 * d, m12 * a + m22 * b, m12 * c + m22 * d
 
+    def smallest_stretch_squared(self) -> np.ndarray:
+        """``sigma2**2`` of every triangle, in the cancellation-free form ``det**2 / sigma1**2``."""
+        det2, norm2 = self.det ** 2, self.norm2
+        return 2.0 * det2 / (norm2 + np.sqrt(np.maximum(norm2 * norm2 - 4.0 * det2, 0.0)))
+
     @property
     def norm2(self) -> np.ndarray:
         """``|J|_F**2 = sigma1**2 + sigma2**2``."""
@@ -181,7 +199,7 @@ def frames(vertices: np.ndarray, faces: np.ndarray, *, local: np.ndarray | None 
     local : (m, 3) complex128, optional
         :func:`patterns.measure.local_coordinates`, if at hand.
     """
-    n, m = len(vertices), len(faces)
+    n = len(vertices)
     z = local_coordinates(vertices, faces) if local is None else local
     r1, r2 = z[:, 1] - z[:, 0], z[:, 2] - z[:, 0]
     # R = [[r1.x, r2.x], [r1.y, r2.y]] (the sides as columns).
@@ -189,14 +207,7 @@ def frames(vertices: np.ndarray, faces: np.ndarray, *, local: np.ndarray | None 
     inverse = (r2.imag / det_r, -r2.real / det_r, -r1.imag / det_r, r1.real / det_r)
     area = 0.5 * np.abs(det_r)
     corners = tuple(np.ascontiguousarray(faces[:, k]) for k in range(3))
-    # Column c < m: +1 at corner 1, -1 at corner 0 of face c; column m + c: corner 2 and corner 0.
-    # Two entries a column, built straight in CSC form (no sort).
-    rows = np.empty(4 * m, dtype=np.int64)
-    rows[0:2 * m:2], rows[1:2 * m:2] = corners[1], corners[0]
-    rows[2 * m::2], rows[2 * m + 1::2] = corners[2], corners[0]
-    data = np.tile([1.0, -1.0], 2 * m)
-    scatter = sp.csc_matrix((data, rows, np.arange(0, 4 * m + 1, 2)), shape=(n, 2 * m))
-    return Frames(faces, inverse, det_r, area / area.mean(), scatter, corners)
+    return Frames(faces, inverse, det_r, area / area.mean(), corners, n)
 
 
 class _TriangleEnergy:
@@ -326,11 +337,7 @@ class InverseTerm(_TriangleEnergy):
 
     def stiffness(self, u: np.ndarray) -> np.ndarray:
         """Per-triangle curvature of ``|J^-1|^2`` relative to the Dirichlet form's, ``(m,)``: ``3 / sigma_min**4``."""
-        jac = self.fr.jacobian(u)
-        det2 = jac.det ** 2
-        norm2 = jac.norm2
-        # sigma_min**2 in the cancellation-free form det**2 / sigma_max**2.
-        smin2 = 2.0 * det2 / (norm2 + np.sqrt(np.maximum(norm2 * norm2 - 4.0 * det2, 0.0)))
+        smin2 = self.fr.jacobian(u).smallest_stretch_squared()
         with np.errstate(divide="ignore", over="ignore"):
             return np.minimum(3.0 / (smin2 * smin2), 1e12)
 

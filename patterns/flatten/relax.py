@@ -275,10 +275,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
 
 def _crushed(fr, uv) -> bool:
     """True when a triangle of ``uv`` is squeezed below ``_CRUSHED`` of its size in some direction."""
-    jac = fr.jacobian(uv)
-    det2, norm2 = jac.det ** 2, jac.norm2
-    smin2 = 2.0 * det2 / (norm2 + np.sqrt(np.maximum(norm2 * norm2 - 4.0 * det2, 0.0)))
-    return bool(smin2.min() < _CRUSHED**2)
+    return bool(fr.jacobian(uv).smallest_stretch_squared().min() < _CRUSHED**2)
 
 
 def _isometric(fr, uv, floor) -> bool:
@@ -374,9 +371,10 @@ class _System:
     the Hessian of ``sum_t W_t |J_t|^2``, ``L(s)`` the cotangent Laplacian
     with each triangle scaled by ``s_t`` (1 for ARAP at an isometry;
     ``1 + 3 / sigma_min**4`` for the symmetric Dirichlet energy, 4 at an
-    isometry) and ``S`` the seam term's stiffness along the held edges.  The plain matrix (``s = 1``) is factorised once in
-    single precision by SuperLU (it only shapes the steps); stiffened ones
-    are refactorised numerically only by qdldl.
+    isometry) and ``S`` the seam term's stiffness along the held edges.  The
+    mesh comes in nested-dissection order, so the plain matrix (``s = 1``) is
+    factorised as it is, once, in single precision by SuperLU (it only shapes
+    the steps); stiffened ones are refactorised numerically only by qdldl.
     """
 
     def __init__(self, conn, fr, free, seam, seam_index):
@@ -386,7 +384,6 @@ class _System:
             np.add.at(self.extra, seam_index, seam.edge_weights())
         weight = self.weights(None)
         self.anchor = float(np.abs(weight).mean()) if free.all() else 0.0
-        # The mesh comes in nested-dissection order (patterns.flatten.numbering): factorised as it is.
         matrix = _laplacian(len(free), conn.edges, weight, anchor=self.anchor)
         self.plain = factorize(matrix if free.all() else matrix[free][:, free], single=True)
         self._stiff = None
