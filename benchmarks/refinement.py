@@ -77,22 +77,20 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import bench_flatten as bench  # noqa: E402  (the libigl recipes and the measuring of the benchmark)
+import bench_flatten as bench
+import build123d as bd
+import trimesh
+from scipy.spatial import Delaunay
 
-import build123d as bd  # noqa: E402
-import trimesh  # noqa: E402
-from scipy.spatial import Delaunay  # noqa: E402
-
-import patterns  # noqa: E402
-from patterns import mesh  # noqa: E402
-from patterns.mesh import corner_angles  # noqa: E402
+import patterns
+from patterns import mesh
+from patterns.mesh import corner_angles
 
 SIZES = {"1k": 1_000, "10k": 10_000, "100k": 100_000}
 """Target face counts, by label."""

@@ -23,7 +23,7 @@ import numpy as np
 
 import patterns
 from patterns import surfaces
-from patterns.flatten import grow
+from patterns.flattening import grow
 from patterns.measure import local_coordinates
 from patterns.mesh import validate_mesh
 

@@ -29,13 +29,13 @@ if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
 import patterns
-from patterns.flatten.embed import lscm, tutte_embedding
-from patterns.flatten.seams import SeamLengths, held_lengths
+from patterns.flattening.embed import lscm, tutte_embedding
+from patterns.flattening.seams import SeamLengths, held_lengths
 from patterns.measure import strain_rms
 from patterns.mesh import unique_edges, validate_mesh
 from patterns.samples import bowl_segment, sphere_gores
 
-relax = importlib.import_module("patterns.flatten.relax")
+relax = importlib.import_module("patterns.flattening.relax")
 
 
 def models():

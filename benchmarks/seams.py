@@ -47,17 +47,14 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import bench_flatten as bench  # noqa: E402  (format_table, machine_summary)
+import bench_flatten as bench
 
-import patterns  # noqa: E402
-from patterns.samples import bowl_segment, sphere_gores  # noqa: E402
+import patterns
+from patterns.samples import bowl_segment, sphere_gores
 
 REPO = Path(__file__).resolve().parent.parent
 

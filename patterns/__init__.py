@@ -12,7 +12,7 @@ The public API, all importable from the top level::
     result.overlap.one_to_one, result.distortion.strain_rms
 """
 
-from .check import Code, Finding, PanelReport, Report, SeamReport, Severity, check
+from .audit import Code, Finding, PanelReport, Report, SeamReport, Severity, check
 from .cut import Cut, cut_to_disk
 from .errors import (
     CadError,
@@ -24,16 +24,16 @@ from .errors import (
     PatternsError,
 )
 from .export import heat_map, preview_dxf
-from .flatten import METHODS, Flattening, flatten, flatten_mesh
-from .flatten.energy import ENERGIES
-from .flatten.seams import Ease, SeamLengths
-from .layout import Layout, layout
-from .load import load, read_cad, read_mesh
+from .flattening import METHODS, Flattening, flatten, flatten_mesh
+from .flattening.energy import ENERGIES
+from .flattening.seams import Ease, SeamLengths
 from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
 from .model import Model, Panel, Seam, Surface, SurfaceKind
+from .nesting import Layout, layout
 from .pattern import FlatPanel, FlatSeam, Pattern
 from .predicates import Overlap, overlap_verdict
+from .reading import load, read_cad, read_mesh
 from .tessellate import mesh_shape, tessellate_face
 
 __version__ = "0.1.0"

@@ -75,7 +75,7 @@ def _direction(text: str):
 
 def _ease(text: str):
     """``SEAM:PANEL:AMOUNT`` (mm, or a percentage with %) as a :class:`patterns.Ease`."""
-    from .flatten.seams import Ease
+    from .flattening.seams import Ease
 
     try:
         seam, panel, amount = text.split(":")
@@ -89,8 +89,8 @@ def _ease(text: str):
 def _parser() -> argparse.ArgumentParser:
     from . import METHODS, __version__
     from .export.dxf import MACHINE_VERSIONS, PROFILES, UNITS
-    from .flatten.energy import ENERGIES
-    from .flatten.seams import SeamLengths
+    from .flattening.energy import ENERGIES
+    from .flattening.seams import SeamLengths
 
     parser = argparse.ArgumentParser(
         prog="patterns", description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns."
@@ -191,7 +191,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _load(args):
-    from .load import CAD_SUFFIXES, MESH_SUFFIXES, load, mesh_model, read_mesh
+    from .reading import CAD_SUFFIXES, MESH_SUFFIXES, load, mesh_model, read_mesh
 
     path = args.input
     suffix = path.suffix.lower()
@@ -205,7 +205,7 @@ def _load(args):
 
 
 def _flatten(model, args):
-    from .flatten import flatten
+    from .flattening import flatten
 
     progress = Progress(f"flattening {len(model.panels)} panels")
     try:
@@ -217,7 +217,7 @@ def _flatten(model, args):
 
 
 def _check(pattern, args):
-    from .check import check
+    from .audit import check
 
     return check(pattern, max_strain=args.max_strain, max_seam_mismatch=args.max_seam_mismatch)
 
@@ -337,10 +337,10 @@ def _cmd_info(args) -> int:
 def _cmd_demo(args) -> int:
     from build123d import export_step
 
-    from .check import check
+    from .audit import check
     from .export.preview import preview_dxf
-    from .flatten import flatten
-    from .load import load
+    from .flattening import flatten
+    from .reading import load
     from .samples import cup
 
     out = args.output
@@ -376,8 +376,8 @@ def _batch_one(path: str, out: str, options: dict) -> dict:
     """Flatten one file into ``out``: a row of the batch summary.  Never raises."""
     from types import SimpleNamespace
 
-    from .check import check
-    from .flatten import flatten
+    from .audit import check
+    from .flattening import flatten
 
     start = time.perf_counter()
     row = {"file": Path(path).name, "panels": None, "seams": None, "strain_rms": None, "strain_max": None,
@@ -413,7 +413,7 @@ def _batch_one(path: str, out: str, options: dict) -> dict:
 def _cmd_batch(args) -> int:
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    from .load import CAD_SUFFIXES, MESH_SUFFIXES
+    from .reading import CAD_SUFFIXES, MESH_SUFFIXES
 
     if not args.folder.is_dir():
         raise InputError(f"{args.folder}: no such folder")

@@ -7,12 +7,15 @@ plane (the 3D <-> 2D map is the vertex index).  Millimetres throughout.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
+import shapely
 
+from .errors import InputError
 from .measure import TriangleStrain, flat_direction, no_strain, triangle_strains
+from .model import SurfaceKind
 
 __all__ = ["FlatPanel", "FlatSeam", "Pattern"]
 
@@ -72,15 +75,12 @@ class FlatPanel:
             the panel) and the bend angle it carries: the turn about the axis
             between neighbouring rulings, degrees.  Empty for any other panel.
         """
-        import shapely
 
-        from .model import SurfaceKind
 
         surface = self.panel.surface
         if self.flattening.method != "exact" or surface is None or surface.kind is SurfaceKind.PLANE:
             return []
         if not (isinstance(spacing, (int, float)) and spacing > 0):
-            from .errors import InputError
 
             raise InputError(f"panel {self.name}: ruling spacing must be a positive number of mm, got {spacing!r}")
         uv = self.flattening.uv
@@ -135,7 +135,6 @@ class FlatPanel:
         """The classic triangulation lines of an oblique cone: apex to points along the
         directrix ``spacing`` mm apart (3D), each with the fold angle between the flat
         facets on either side of it."""
-        import shapely
 
         d3 = surface.directrix
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(d3, axis=0), axis=1))])
@@ -327,12 +326,12 @@ class Pattern:
 
     def layout(self, *, width: float, gap: float = 10.0, margin: float = 0.0, allow_rotation: bool = True,
                respect_grain: bool = True, step: float | None = None):
-        """Nest the panels on a roll ``width`` mm wide; see :func:`patterns.layout.layout`.
+        """Nest the panels on a roll ``width`` mm wide; see :func:`patterns.nesting.layout`.
 
-        Returns a :class:`patterns.layout.Layout`: ``.pattern`` (laid out),
+        Returns a :class:`patterns.nesting.Layout`: ``.pattern`` (laid out),
         ``.length`` used, ``.efficiency``.
         """
-        from .layout import layout
+        from .nesting import layout
 
         return layout(self, width=width, gap=gap, margin=margin, allow_rotation=allow_rotation,
                       respect_grain=respect_grain, step=step)
@@ -349,9 +348,7 @@ class Pattern:
         Rotation (radians) about the origin of the flattened panel, then a
         translation (mm).  Nothing is scaled; seams' flat lengths are unchanged.
         """
-        from dataclasses import replace
 
-        from .errors import InputError
 
         placements = list(placements)
         if len(placements) != len(self.panels):

@@ -9,8 +9,8 @@ covered as many times as the boundary winds around it, i.e. once inside the
 polygon and never outside, so the map is one-to-one.  Otherwise the verdict
 says what failed and where.
 
-A kernel beneath the engine (:mod:`patterns.flatten` keeps its layouts
-one-to-one with these) and the report (:mod:`patterns.check` turns them into
+A kernel beneath the engine (:mod:`patterns.flattening` keeps its layouts
+one-to-one with these) and the report (:mod:`patterns.audit` turns them into
 findings).
 """
 
@@ -22,7 +22,6 @@ import numpy as np
 import shapely
 
 from .measure import folded_faces
-from .mesh import _readonly
 
 __all__ = ["Overlap", "boundary_crossings", "crossing_segments", "overlap_verdict"]
 

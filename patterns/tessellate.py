@@ -13,6 +13,7 @@ from scipy.sparse import csgraph
 from .cut import cut_to_disk
 from .errors import CadError, InputError
 from .mesh import drop_unused, face_areas, unique_ints, validate_mesh
+from .model import Model, Panel, Seam, Surface, SurfaceKind
 from .options import check_number
 
 __all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
@@ -388,7 +389,6 @@ class _ShapeMesher:
         from OCP.BRepTools import BRepTools
         from OCP.GProp import GProp_GProps
 
-        from .model import Model
 
         areas, self.surfaces, self.devs = [], [], []
         for k, face in enumerate(self.faces):
@@ -657,7 +657,6 @@ class _ShapeMesher:
 
     # -- panels and seams ----------------------------------------------------
     def _assemble(self, groups, meshes):
-        from .model import Panel, Seam
 
         points = np.asarray(self._points, dtype=np.float64)
         offsets = np.cumsum([0] + [len(m.slot_gid) + len(m.interior) for m in meshes])
@@ -754,7 +753,6 @@ def surface_of(surface, face, dev=None):
     transition); else None."""
     from OCP.GeomAbs import GeomAbs_Cone, GeomAbs_Cylinder, GeomAbs_Plane
 
-    from .model import Surface, SurfaceKind
 
     kind = surface.GetType()
     if kind not in (GeomAbs_Plane, GeomAbs_Cylinder, GeomAbs_Cone):
@@ -785,7 +783,6 @@ def _general_cone(surface, dev):
     parameter grid: one side of the grid collapses to a point and every grid line
     from there is straight.  Returns its apex and a dense sample of the opposite
     boundary (the directrix), or None."""
-    from .model import Surface, SurfaceKind
 
     pts = dev.points  # (nv, nu, 3): rows along u at fixed v
     size = float(np.ptp(pts.reshape(-1, 3), axis=0).max())

@@ -8,7 +8,7 @@ import pytest
 
 import patterns
 from patterns import surfaces
-from patterns.check import Code, Severity
+from patterns.audit import Code, Severity
 from patterns.errors import ExportError, InputError
 
 from .conftest import SAMPLES
@@ -162,7 +162,7 @@ def test_crossing_outline_is_caught_at_the_crossing():
     angle = s_ / 600.0 * 2.4 * np.pi
     radius = 100.0 + t_
     uv = np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
-    from patterns.check import boundary_crossings
+    from patterns.audit import boundary_crossings
 
     crossings = boundary_crossings(uv, r.loops)
     assert crossings and crossings[0][0] == crossings[0][1] == 0

@@ -14,7 +14,7 @@ import shapely
 from ezdxf import recover
 
 import patterns
-from patterns.load import read_mesh
+from patterns.reading import read_mesh
 
 from .conftest import SAMPLES
 

@@ -1,11 +1,11 @@
-"""The relaxation's energies (patterns.flatten.energy) against independent computations."""
+"""The relaxation's energies (patterns.flattening.energy) against independent computations."""
 
 import numpy as np
 import pytest
 
 import patterns
 from patterns import surfaces
-from patterns.flatten.energy import Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, frames
+from patterns.flattening.energy import Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, frames
 from patterns.mesh import validate_mesh
 
 

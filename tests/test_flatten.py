@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 import patterns
 from patterns import surfaces
 from patterns.errors import FlattenError, InputError, MeshTopologyError
-from patterns.flatten import grow
+from patterns.flattening import grow
 from patterns.measure import local_coordinates
 from patterns.mesh import validate_mesh
 
@@ -315,7 +315,7 @@ def test_surface_with_holes_flattens_one_to_one():
 @pytest.mark.parametrize("path", corpus_files())
 @pytest.mark.parametrize("method", patterns.METHODS)
 def test_corpus_verdict_is_truthful(path, method):
-    from patterns.load import read_mesh
+    from patterns.reading import read_mesh
 
     mesh = read_mesh(path)
     try:

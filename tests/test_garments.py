@@ -142,8 +142,8 @@ def test_nesting_errors():
 
 
 def test_darts_relieve_a_hemisphere_and_never_leave_it_worse():
-    from patterns.load import mesh_model
     from patterns.measure import triangle_strains
+    from patterns.reading import mesh_model
 
     v, f = patterns.surfaces.spherical_cap(radius=100.0, half_angle=90.0, n_faces=2000)
     model = mesh_model(v, f, name="hemisphere")

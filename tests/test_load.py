@@ -7,7 +7,7 @@ from scipy.spatial import cKDTree
 
 from patterns import surfaces
 from patterns.errors import InputError
-from patterns.load import read_mesh
+from patterns.reading import read_mesh
 
 from .conftest import SAMPLES
 

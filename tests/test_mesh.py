@@ -145,8 +145,8 @@ def test_column_helpers_match_the_row_formulas():
 
 
 def test_sort_based_unique_matches_numpy():
-    from patterns.load import _unique_rows
     from patterns.mesh import unique_edges, unique_ints
+    from patterns.reading import _unique_rows
 
     rng = np.random.default_rng(2)
     for size in (0, 1, 7, 5000):

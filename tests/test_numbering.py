@@ -1,4 +1,4 @@
-"""Nested-dissection numberings (patterns.flatten.numbering) and what they buy: a pattern
+"""Nested-dissection numberings (patterns.flattening.numbering) and what they buy: a pattern
 whose time and strain do not depend on how the input was numbered, nor on the thread count."""
 
 import os
@@ -11,7 +11,7 @@ import scipy.sparse as sp
 
 import patterns
 from patterns import surfaces
-from patterns.flatten.numbering import dissection_order, renumber, renumber_connectivity
+from patterns.flattening.numbering import dissection_order, renumber, renumber_connectivity
 from patterns.mesh import validate_mesh
 
 from .helpers import rigid_fit_residual

@@ -6,10 +6,10 @@ import pytest
 import patterns
 from patterns import surfaces
 from patterns.errors import InputError
-from patterns.flatten.embed import lscm, tutte_embedding
-from patterns.flatten.relax import best_scale, flip_free_steps
-from patterns.load import read_mesh
+from patterns.flattening.embed import lscm, tutte_embedding
+from patterns.flattening.relax import best_scale, flip_free_steps
 from patterns.mesh import validate_mesh
+from patterns.reading import read_mesh
 
 from .helpers import independent_one_to_one, rigid_fit_residual
 
@@ -201,7 +201,7 @@ def test_ldl_refactorisations_solve_each_new_system_and_refuse_stale_factors():
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from patterns.flatten.relax import _laplacian, _StiffLaplacian
+    from patterns.flattening.relax import _laplacian, _StiffLaplacian
 
     v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=3000)
     v, f, conn = validate_mesh(v, f)
@@ -276,9 +276,9 @@ def test_lscm_solves_the_real_least_squares_problem():
 def test_single_precision_factor_is_a_close_unit_free_preconditioner():
     """The relaxation's preconditioner is factorised in float32; its solves must
     stay close to the float64 ones and must not depend on the unit."""
-    from patterns.flatten.embed import factorize
-    from patterns.flatten.numbering import dissection_order
-    from patterns.flatten.relax import _laplacian
+    from patterns.flattening.embed import factorize
+    from patterns.flattening.numbering import dissection_order
+    from patterns.flattening.relax import _laplacian
 
     v, f = surfaces.ellipsoid_cup(n_faces=10_000)
     v, f, conn = validate_mesh(v, f)

@@ -5,7 +5,7 @@ import pytest
 
 import patterns
 from patterns import Ease
-from patterns.check import Code
+from patterns.audit import Code
 from patterns.errors import InputError
 from patterns.samples import bowl_segment, sphere_gores
 

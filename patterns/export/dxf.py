@@ -7,13 +7,21 @@ declared in the header.
 
 from __future__ import annotations
 
+import logging
+import re
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
+import shapely
+from shapely.geometry.polygon import orient
 
 from ..errors import InputError
-from ..options import check_number, is_number
 from ..files import atomic_output
+from ..measure import strain_stats, triangle_strains
+from ..options import check_number, is_number
+from .arcs import fit_arcs
+from .heatmap import display_offsets
 
 __all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "PROFILES", "UNITS", "seam_label",
            "write_outline_dxf", "write_pattern_dxf"]
@@ -96,7 +104,6 @@ class _PanelGeometry:
     """Flat geometry of one panel as it goes into the file (mm, placed)."""
 
     def __init__(self, pattern, index, offset, allowances, text_height, corners="mitre"):
-        import shapely
 
         flat = pattern.panels[index]
         self.name = flat.name
@@ -124,7 +131,6 @@ class _PanelGeometry:
         self.label_at = inside
         box = np.ptp(self.seam_loops[0], axis=0)
         self.text_height = text_height if text_height else float(np.clip(0.03 * box.max(), 2.0, 12.0))
-        from ..measure import strain_stats
 
         stats = strain_stats(flat.strains)  # the same numbers as patterns.check's report
         self.strain_rms, self.strain_max = stats.rms, stats.max
@@ -151,7 +157,6 @@ def _allowance_outline(polygon, loops, per_segment, corners="mitre"):
     towards the material's outside) each side's allowance is run straight on
     past the corner by its own width, so the corner is squared off.
     """
-    import shapely
 
     values = np.concatenate(per_segment)
     base = float(values.min())
@@ -186,7 +191,6 @@ def _allowance_outline(polygon, loops, per_segment, corners="mitre"):
 
 def _square_allowance(polygon, loops, per_segment):
     """Allowance with squared corners: each run between sharp corners offset on its own, extended."""
-    import shapely
 
     parts = [polygon]
     for loop, allow in zip(loops, per_segment):
@@ -263,7 +267,6 @@ def _readable_angle(direction) -> float:
 
 def _seam_annotations(pattern, geo):
     """``(text, position (2,), angle degrees)`` for every seam side on the panel, at its middle, inside."""
-    import shapely
 
     out = []
     for fs in pattern.seams:
@@ -331,7 +334,6 @@ def notch_positions(flat_seam, side: int, uv: np.ndarray, spacing: float | None)
 
 def _notches(pattern, geo, allowance_of, spacing=None):
     """``(point on the seam line, outward normal, depth, outward?)`` for every notch on the panel."""
-    import shapely
 
     out = []
     for fs in pattern.seams:
@@ -360,7 +362,6 @@ def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance
     """
     import ezdxf
 
-    from .heatmap import display_offsets
 
     if profile not in PROFILES:
         raise InputError(f"{path}: unknown DXF profile {profile!r}; choose one of {', '.join(PROFILES)}")
@@ -423,7 +424,6 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, stra
 
     def poly(points, layer, close=True):
         if arc_tolerance is not None and layer == "CUT":
-            from .arcs import fit_arcs
 
             fitted = fit_arcs(np.asarray(points), arc_tolerance)
             fitted[:, :2] *= scale
@@ -487,8 +487,6 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, stra
 def _save(doc, path) -> None:
     """Save with fixed metadata (dates 2000-01-01, constant GUIDs): the same pattern and
     options always give a byte-identical file."""
-    import re
-    from pathlib import Path
 
     import ezdxf
 
@@ -508,7 +506,6 @@ def _save(doc, path) -> None:
 
 def _new_doc(ezdxf, version, units):
     """``ezdxf.new`` without its warning that R12 has no ``$INSUNITS`` (we know, and say it in a text)."""
-    import logging
 
     log = logging.getLogger("ezdxf")
     level = log.level
@@ -533,7 +530,6 @@ def _grain_line(g):
 
 
 def _inside(polygon, point) -> bool:
-    import shapely
 
     return bool(shapely.contains_xy(polygon, *point))
 
@@ -543,7 +539,6 @@ def _strain_solids(msp, flat, uv, scale, truecolor):
     from matplotlib import colormaps
     from matplotlib.colors import TwoSlopeNorm
 
-    from ..measure import triangle_strains
 
     s = triangle_strains(flat.vertices, flat.faces, flat.uv).dominant
     lim = max(float(np.max(np.abs(s))), 1e-6)
@@ -611,7 +606,6 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets, notch_s
 
 
 def _block_name(name: str, used: set) -> str:
-    import re
 
     base = re.sub(r"[^A-Za-z0-9_\-]", "_", name)[:31] or "PIECE"
     out, k = base, 1
@@ -633,6 +627,5 @@ def _turning(loop: np.ndarray) -> np.ndarray:
 
 def _orient(polygon):
     """Exterior counter-clockwise, interiors clockwise (shapely < 2.1)."""
-    from shapely.geometry.polygon import orient
 
     return orient(polygon, 1.0)

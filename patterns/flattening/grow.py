@@ -290,86 +290,15 @@ def grow_heap(z: np.ndarray, faces: np.ndarray, conn: Connectivity, weights: np.
     Parameters and return as :func:`grow_fronts`.
     """
     n = conn.n_vertices
-    faces_l = faces.tolist()
-    zl = z.tolist()
-    wl = weights.tolist()
-    rl = [None] * len(faces_l) if rotations is None else rotations.tolist()
-    ptr = conn.vertex_faces_ptr.tolist()
-    vf = conn.vertex_faces.tolist()
-    pos: list = [None] * n
-    count = [0] * len(faces_l)
-    version = [0] * n
-
-    def ready_faces(v):
-        out = []
-        for f in vf[ptr[v]:ptr[v + 1]]:
-            if count[f] == 2:
-                tri = faces_l[f]
-                j = tri.index(v)
-                out.append((f, j))
-        return out
-
-    def priority(v):
-        added: dict = {}
-        delta = 0.0
-        for f, j in ready_faces(v):
-            zf = zl[f]
-            za, zb, zc = zf[(j + 1) % 3], zf[(j + 2) % 3], zf[j]
-            delta -= abs(zb - za)
-            tri = faces_l[f]
-            for other, zo in ((tri[(j + 1) % 3], za), (tri[(j + 2) % 3], zb)):
-                added[other] = (added.get(other, (0, 0.0))[0] + 1, abs(zc - zo))
-        for k, length in added.values():
-            if k == 1:
-                delta += length
-        return delta
-
-    heap: list = []
-    quantum = 1e-6 * float(np.mean(np.abs(z[:, 1] - z[:, 0])))
-
-    def key(v):
-        return round(priority(v) / quantum)
-
-    def place(v, position):
-        pos[v] = position
-        for f in vf[ptr[v]:ptr[v + 1]]:
-            count[f] += 1
-        for f in vf[ptr[v]:ptr[v + 1]]:
-            for u in faces_l[f]:
-                if pos[u] is None:
-                    version[u] += 1
-                    if ready_faces(u):
-                        heapq.heappush(heap, (key(u), u, version[u]))
-
-    tri = faces_l[seed]
-    seed_w = seed_layout(z[seed]).tolist()
-    for v, position in zip(tri, seed_w):
-        pos[v] = position
-    for v in tri:
-        for f in vf[ptr[v]:ptr[v + 1]]:
-            count[f] += 1
-    for v in tri:
-        for f in vf[ptr[v]:ptr[v + 1]]:
-            for u in faces_l[f]:
-                if pos[u] is None and ready_faces(u):
-                    version[u] += 1
-                    heapq.heappush(heap, (key(u), u, version[u]))
+    front = _ShortestFront(z, faces, conn, weights, rotations)
+    front.start(seed, seed_layout(z[seed]).tolist())
     n_placed = 3
     every = max(1, n // 100)
-    while heap:
-        _, v, ver = heapq.heappop(heap)
-        if pos[v] is not None or ver != version[v]:
+    while front.heap:
+        _, v, ver = heapq.heappop(front.heap)
+        if front.pos[v] is not None or ver != front.version[v]:
             continue
-        total = 0.0
-        acc = 0j
-        for f, j in ready_faces(v):
-            zf = zl[f]
-            tri = faces_l[f]
-            a, b = tri[(j + 1) % 3], tri[(j + 2) % 3]
-            cand = step(zf[(j + 1) % 3], zf[(j + 2) % 3], zf[j], pos[a], pos[b], rl[f])
-            acc += wl[f] * cand
-            total += wl[f]
-        place(v, acc / total)
+        front.place(v, front.candidate(v, step))
         n_placed += 1
         if progress is not None and n_placed % every == 0:
             progress(n_placed, n)
@@ -377,4 +306,81 @@ def grow_heap(z: np.ndarray, faces: np.ndarray, conn: Connectivity, weights: np.
         raise FlattenError(f"the grower reached {n_placed} of {n} vertices")
     if progress is not None:
         progress(n, n)
-    return np.asarray(pos, dtype=np.complex128)
+    return np.asarray(front.pos, dtype=np.complex128)
+
+
+class _ShortestFront:
+    """The state of :func:`grow_heap`: placed positions, the heap of candidates, per-face counts (Python lists)."""
+
+    def __init__(self, z, faces, conn, weights, rotations):
+        n = conn.n_vertices
+        self.faces = faces.tolist()
+        self.z = z.tolist()
+        self.w = weights.tolist()
+        self.r = [None] * len(self.faces) if rotations is None else rotations.tolist()
+        self.ptr = conn.vertex_faces_ptr.tolist()
+        self.vf = conn.vertex_faces.tolist()
+        self.pos: list = [None] * n
+        self.count = [0] * len(self.faces)
+        self.version = [0] * n
+        self.heap: list = []
+        self.quantum = 1e-6 * float(np.mean(np.abs(z[:, 1] - z[:, 0])))
+
+    def faces_of(self, v):
+        return self.vf[self.ptr[v]:self.ptr[v + 1]]
+
+    def ready_faces(self, v):
+        """``[(face, corner of v)]``: the faces of ``v`` whose two other corners are placed."""
+        return [(f, self.faces[f].index(v)) for f in self.faces_of(v) if self.count[f] == 2]
+
+    def key(self, v):
+        """How much placing ``v`` lengthens the front (3D), on the grid of ``quantum``."""
+        added: dict = {}
+        delta = 0.0
+        for f, j in self.ready_faces(v):
+            zf, tri = self.z[f], self.faces[f]
+            za, zb, zc = zf[(j + 1) % 3], zf[(j + 2) % 3], zf[j]
+            delta -= abs(zb - za)
+            for other, zo in ((tri[(j + 1) % 3], za), (tri[(j + 2) % 3], zb)):
+                added[other] = (added.get(other, (0, 0.0))[0] + 1, abs(zc - zo))
+        for k, length in added.values():
+            if k == 1:
+                delta += length
+        return round(delta / self.quantum)
+
+    def start(self, seed, positions):
+        """Lay the seed triangle's corners at ``positions`` and queue their neighbours."""
+        tri = self.faces[seed]
+        for v, position in zip(tri, positions):
+            self.pos[v] = position
+        for v in tri:
+            for f in self.faces_of(v):
+                self.count[f] += 1
+        for v in tri:
+            for f in self.faces_of(v):
+                for u in self.faces[f]:
+                    if self.pos[u] is None and self.ready_faces(u):
+                        self.version[u] += 1
+                        heapq.heappush(self.heap, (self.key(u), u, self.version[u]))
+
+    def place(self, v, position):
+        """Put ``v`` at ``position`` and requeue its free neighbours (older entries go stale)."""
+        self.pos[v] = position
+        for f in self.faces_of(v):
+            self.count[f] += 1
+        for f in self.faces_of(v):
+            for u in self.faces[f]:
+                if self.pos[u] is None:
+                    self.version[u] += 1
+                    if self.ready_faces(u):
+                        heapq.heappush(self.heap, (self.key(u), u, self.version[u]))
+
+    def candidate(self, v, step):
+        """Where ``v`` goes: the area-weighted mean of ``step`` over its ready faces."""
+        total, acc = 0.0, 0j
+        for f, j in self.ready_faces(v):
+            zf, tri = self.z[f], self.faces[f]
+            a, b = tri[(j + 1) % 3], tri[(j + 2) % 3]
+            acc += self.w[f] * step(zf[(j + 1) % 3], zf[(j + 2) % 3], zf[j], self.pos[a], self.pos[b], self.r[f])
+            total += self.w[f]
+        return acc / total

@@ -1,7 +1,7 @@
 """Fold-free relaxation of a flat layout: least distortion of the surface-to-plane map.
 
 The relaxation minimises an area-weighted distortion energy of the map from
-the surface to the plane (:mod:`patterns.flatten.energy`) -- by default
+the surface to the plane (:mod:`patterns.flattening.energy`) -- by default
 ``"arap"``, the sum of squared principal strains weighted by 3D area, the
 material's strain -- while every triangle keeps its orientation and the flat
 boundary never crosses itself.  Chosen edges (the seams of a pattern) can be
@@ -31,7 +31,7 @@ Method
   the energy drops (Armijo) and the boundary loops are still a valid polygon
   (shapely).  A start without folds and with valid loops therefore ends
   without folds and without overlap, by the same degree argument as
-  :mod:`patterns.check`.  Nothing is ever rescaled.
+  :mod:`patterns.audit`.  Nothing is ever rescaled.
 * **Pins** are reached first by stress-majorization steps cut vertex by vertex
   (:func:`_travel_to_pins`), then held while the rest relaxes.
 """
@@ -185,7 +185,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
     start : (n, 2) float64
         A layout without folded triangles and with valid boundary loops.
     energy : {"auto", "arap", "hybrid", "symmetric-dirichlet"}
-        The distortion minimised (:mod:`patterns.flatten.energy`).  ``"auto"``
+        The distortion minimised (:mod:`patterns.flattening.energy`).  ``"auto"``
         minimises ARAP, the squared principal strains; where its fold-free
         minimum presses a triangle flat (a stretch below 1e-3: the layout
         that least strains the material would fold there), it goes on from
@@ -597,7 +597,7 @@ class _StiffLaplacian:
     """The weighted Laplacian's free block, refactorised for new edge weights.
 
     The same matrix as ``_laplacian(n, edges, weight, anchor=anchor)[free][:, free]``;
-    the pattern never changes, so an :class:`~patterns.flatten.embed.LDL` keeps
+    the pattern never changes, so an :class:`~patterns.flattening.embed.LDL` keeps
     its ordering and elimination tree and each refactorisation is numeric only.
     Each :meth:`factorize` overwrites the previous factor.
     """

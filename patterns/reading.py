@@ -24,8 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .cut import cut_to_disk, pieces
 from .errors import CadError, InputError
 from .mesh import as_mesh_arrays, drop_unused, unique_ints, validate_mesh
+from .model import Model, Panel, Seam
+from .tessellate import mesh_shape
 
 __all__ = ["CAD_SUFFIXES", "MESH_SUFFIXES", "MeshFile", "drop_unused", "load", "mesh_model", "read_cad", "read_mesh", "weld"]
 
@@ -258,8 +261,6 @@ def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max
     MeshTopologyError
         A mesh piece that is non-manifold, inconsistently wound, or has handles.
     """
-    from .tessellate import mesh_shape
-
     if isinstance(source, (str, Path)):
         path = Path(source)
         suffix = path.suffix.lower()
@@ -298,8 +299,6 @@ def mesh_model(vertices, faces, *, name: str = "mesh"):
         Panels ``piece0``, ``piece1``, ... in order of their first face;
         seams are the cuts (``cad_edge`` None, both sides on one panel).
     """
-    from .cut import cut_to_disk, pieces
-    from .model import Model, Panel, Seam
 
     v, f = as_mesh_arrays(vertices, faces, name=name)
     panels, seams = [], []

@@ -19,6 +19,7 @@ import qdldl
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..measure import local_coordinates
 from ..mesh import Connectivity
 from .numbering import dissection_order
 
@@ -60,7 +61,7 @@ def factorize(matrix: sp.spmatrix, *, single: bool = False, order: np.ndarray | 
         third faster to factorise and to solve with, for a preconditioner that
         need not be exact.  :meth:`Factor.solve` still takes and returns float64.
     order : (n,) int64, optional
-        The elimination order (:func:`patterns.flatten.numbering.dissection_order`),
+        The elimination order (:func:`patterns.flattening.numbering.dissection_order`),
         or None for ``arange(n)``: the matrix is already in a good order.
         SuperLU's own minimum-degree orderings depend on how the input was
         numbered (a factor of 2-10 in time), so the engine never uses them.
@@ -218,7 +219,6 @@ def lscm(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, *, local: 
     -------
     (n, 2) float64
     """
-    from ..measure import local_coordinates
 
     n, m = len(vertices), len(faces)
     z = local_coordinates(vertices, faces) if local is None else local

@@ -23,11 +23,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import FlattenError, InputError
+from ..measure import signed_areas
+from ..mesh import _readonly, validate_mesh
 from ..model import SurfaceKind
 from ..options import check_number
+from ..predicates import overlap_verdict
+from .engine import Flattening
 
-__all__ = ["REFERENCES", "develop", "neutral_offset", "offset_points"]
+__all__ = ["REFERENCES", "develop", "developed", "neutral_offset", "offset_along_normals", "offset_points"]
 
 REFERENCES = ("inside", "outside", "mid")
 """Which skin of the sheet the CAD model shows."""
@@ -158,3 +162,27 @@ def _develop_general_cone(surface, points: np.ndarray) -> np.ndarray:
             best = np.where(better, value, best)
     out[~at_apex] = np.column_stack([s[~at_apex] * np.cos(best), s[~at_apex] * np.sin(best)])
     return out
+
+
+def developed(panel, offset: float, name: str) -> Flattening:
+    """The exact development of a planar, cylindrical or conical panel (of its offset by ``offset``)."""
+    vertices = offset_points(panel.surface, panel.vertices, offset)
+    uv = develop(panel.surface, vertices, panel.param, offset=offset)
+    if np.sum(signed_areas(panel.faces, uv)) < 0:
+        uv[:, 0] = -uv[:, 0]  # the parametrisation runs the other way round: mirror (an isometry)
+    if not np.all(np.isfinite(uv)):
+        raise FlattenError(f"{name}: the exact development gave non-finite coordinates")
+    v, f, conn = validate_mesh(vertices, panel.faces, name=name)
+    return Flattening(uv=_readonly(uv), vertices=_readonly(v), faces=_readonly(f), loops=conn.loops,
+                      method="exact", seed_face=-1, overlap=overlap_verdict(f, uv, conn.loops), start="analytic")
+
+
+def offset_along_normals(panel, offset: float) -> np.ndarray:
+    """Panel vertices moved by ``offset`` along their area-weighted normals (freeform sheet thickness)."""
+    v, f = panel.vertices, panel.faces
+    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])  # length = 2 x area: area-weighted
+    vn = np.zeros_like(v)
+    for k in range(3):
+        np.add.at(vn, f[:, k], n)
+    vn /= np.maximum(np.linalg.norm(vn, axis=1, keepdims=True), 1e-300)
+    return v + offset * vn

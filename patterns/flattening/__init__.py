@@ -1,0 +1,18 @@
+"""Flattening: 3D triangle meshes to 1:1 flat patterns.
+
+* :mod:`~patterns.flattening.engine`: :func:`flatten_mesh` (arrays in, a frozen
+  :class:`Flattening` out) -- the growers (:mod:`~patterns.flattening.grow`),
+  the relaxation (:mod:`~patterns.flattening.relax`,
+  :mod:`~patterns.flattening.energy`), the starts
+  (:mod:`~patterns.flattening.embed`) and numberings
+  (:mod:`~patterns.flattening.numbering`);
+* :mod:`~patterns.flattening.panels`: :func:`flatten` (a ``Model`` in, a
+  ``Pattern`` out), with exact developments (:mod:`~patterns.flattening.develop`),
+  held seams (:mod:`~patterns.flattening.seams`), darts
+  (:mod:`~patterns.flattening.darts`) and grain (:mod:`~patterns.flattening.grain`).
+"""
+
+from .engine import METHODS, Flattening, flatten_mesh
+from .panels import flatten
+
+__all__ = ["METHODS", "Flattening", "flatten", "flatten_mesh"]

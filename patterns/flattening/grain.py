@@ -1,0 +1,44 @@
+"""The grain: turn each flat panel so that a 3D direction points along +Y."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..errors import InputError
+from ..measure import flat_direction
+from ..mesh import _readonly
+from .engine import Flattening
+
+__all__ = ["grain_table", "turn_to_grain"]
+
+
+def grain_table(grain, model) -> dict:
+    """``{panel name: unit (3,) direction}`` from ``flatten(grain=...)``."""
+    if grain is None:
+        return {}
+    names = [p.name for p in model.panels]
+    items = grain.items() if hasattr(grain, "items") else [(n, grain) for n in names]
+    out = {}
+    for name, direction in items:
+        if name not in names:
+            raise InputError(f"{model.name}: grain names panel {name!r}, which the model does not have")
+        try:
+            d = np.asarray(direction, dtype=np.float64).reshape(3)
+        except (TypeError, ValueError):
+            raise InputError(f"{model.name}: a grain is a 3D direction (x, y, z), got {direction!r}") from None
+        if not np.all(np.isfinite(d)) or np.linalg.norm(d) == 0:
+            raise InputError(f"{model.name}: a grain is a non-zero 3D direction, got {direction!r}")
+        out[name] = d / np.linalg.norm(d)
+    return out
+
+
+def turn_to_grain(result: Flattening, direction) -> Flattening:
+    """The flattening turned about its centre so that ``direction`` points along +Y (a rotation)."""
+    d = flat_direction(result.vertices, result.faces, result.uv, direction)
+    angle = np.pi / 2 - np.arctan2(d[1], d[0])
+    c, s = np.cos(angle), np.sin(angle)
+    centre = result.uv.mean(axis=0)
+    uv = (result.uv - centre) @ np.array([[c, s], [-s, c]]) + centre
+    return replace(result, uv=_readonly(uv))
