@@ -1,21 +1,31 @@
-"""One validator for the numbers every option takes.
+"""Options: declared once, validated once, for the API and the command line alike.
 
-Every numeric option of the API (and so of the command line, which calls it)
-is checked here, the same way: a real number (Python or numpy, never a
-``bool``), finite unless said otherwise, within its bounds; an
-:class:`~patterns.errors.InputError` naming the option and what it takes
-otherwise.
+* :func:`check_number`: every numeric option of the API (and so of the command
+  line) is checked here, the same way: a real number (Python or numpy, never a
+  ``bool``), finite unless said otherwise, within its bounds; an
+  :class:`~patterns.errors.InputError` naming the option and what it takes
+  otherwise.
+* :class:`Options`: the frozen option records (``LoadOptions``,
+  ``FlattenOptions``, ``CheckOptions``, ``DxfOptions``), each field declared
+  once with :func:`option`; the API makes them from its keywords
+  (:meth:`Options.of`), the command line makes its flags from the same fields
+  (:func:`add_arguments`) and the records from the parsed flags
+  (:func:`from_arguments`).
 """
 
 from __future__ import annotations
 
 import numbers
+from collections.abc import Callable
+from dataclasses import dataclass, field, fields, replace
+from enum import Enum
+from typing import Any
 
 import numpy as np
 
 from .errors import InputError
 
-__all__ = ["check_number", "is_number"]
+__all__ = ["Options", "Spec", "add_arguments", "check_number", "cli_flags", "from_arguments", "is_number", "option"]
 
 
 def is_number(value, *, integer: bool = False) -> bool:
@@ -70,3 +80,209 @@ def _describe(low, high, low_open, high_open, integer) -> str:
     if high is not None:
         return f"{article} {kind} {'<' if high_open else '<='} {high:g}"
     return f"a finite {kind}"
+
+
+# --------------------------------------------------------------------------- #
+# Option records: one declaration per option, for the API and the CLI alike
+# --------------------------------------------------------------------------- #
+
+
+@dataclass(frozen=True)
+class Spec:
+    """What one option takes, and its help: the declaration the API validates with and the CLI is made from.
+
+    Attributes
+    ----------
+    help : str
+        One or two sentences, shown by ``--help`` and in the record's docstring.
+    low, high, low_open, high_open, integer
+        A number's bounds (see :func:`check_number`); a number option has
+        ``low`` or ``high`` or ``integer`` set, or a numeric default.
+    choices : tuple of str, optional
+        The values a choice takes.
+    optional : bool
+        None is accepted (and means "not set").
+    flag : str, optional
+        The CLI flag; default ``--`` and the name with dashes.  Two records
+        may share a flag (``--units``): the one value goes to both.
+    parse : callable, optional
+        CLI text to value (for values other than numbers and choices).
+    check : callable, optional
+        ``check(value, option) -> value`` for values other than numbers,
+        choices and booleans (raises :class:`~patterns.errors.InputError`).
+    repeat : bool
+        The CLI flag may be given several times; the values come as a list.
+    metavar : str, optional
+    """
+
+    help: str
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+    integer: bool = False
+    choices: tuple | None = None
+    optional: bool = False
+    flag: str | None = None
+    parse: Callable | None = None
+    check: Callable | None = None
+    repeat: bool = False
+    metavar: str | None = None
+
+    def validate(self, value, option: str, default):
+        """``value`` checked (numbers as Python numbers), or InputError naming ``option``."""
+        if value is None and (self.optional or default is None):
+            return None
+        if self.check is not None:
+            return self.check(value, option)
+        if self.choices is not None:
+            if isinstance(value, Enum):
+                value = value.value
+            if not isinstance(value, str) or value not in self.choices:
+                raise InputError(f"{option} must be one of {', '.join(map(str, self.choices))}, got {value!r}")
+            return value
+        if isinstance(default, bool):
+            if not isinstance(value, (bool, np.bool_)):
+                raise InputError(f"{option} must be True or False, got {value!r}")
+            return bool(value)
+        if self.integer or self.low is not None or self.high is not None or is_number(default):
+            return check_number(value, option, low=self.low, high=self.high, low_open=self.low_open,
+                                high_open=self.high_open, integer=self.integer)
+        return value
+
+
+def option(default, help: str, **spec) -> Any:
+    """A field of an :class:`Options` record: its default and its :class:`Spec` (keywords as there)."""
+    return field(default=default, metadata={"spec": Spec(help, **spec)})
+
+
+class Options:
+    """Base of the frozen option records (:class:`~patterns.export.dxf.DxfOptions`, ...).
+
+    Each field is declared once, with :func:`option`; the record checks every
+    value when it is made (``InputError`` naming the option), the API builds
+    it from its keywords (:meth:`of`), and the command line makes its flags
+    from the same fields (:func:`add_arguments`, :func:`from_arguments`), so
+    that the two cannot drift.  Subclasses are frozen dataclasses.
+    """
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        cls.__doc__ = (cls.__doc__ or "").rstrip() + "\n\n    Attributes\n    ----------\n" + "".join(
+            f"    {name}\n        {spec.help}\n" for name, spec in _specs_from_annotations(cls))
+
+    def __post_init__(self):
+        for f in fields(self):
+            spec = f.metadata.get("spec")
+            if spec is not None:
+                object.__setattr__(self, f.name, spec.validate(getattr(self, f.name), f.name, f.default))
+
+    @classmethod
+    def of(cls, options=None, keywords=None, *, name: str | None = None):
+        """The record from ``options`` (a record of this kind, or None) with ``keywords`` over it.
+
+        Raises
+        ------
+        InputError
+            ``options`` of another kind, an unknown keyword, or a bad value;
+            the message starts with ``name`` when given.
+        """
+        prefix = f"{name}: " if name else ""
+        if options is not None and not isinstance(options, cls):
+            raise InputError(f"{prefix}options must be a patterns {cls.__name__}, got {type(options).__name__}")
+        keywords = dict(keywords or {})
+        known = [f.name for f in fields(cls)]
+        unknown = sorted(set(keywords) - set(known))
+        if unknown:
+            raise InputError(f"{prefix}unknown option {unknown[0]!r}; the options are {', '.join(known)}")
+        try:
+            return replace(options, **keywords) if options is not None else cls(**keywords)
+        except InputError as exc:
+            raise InputError(f"{prefix}{exc}") from None
+
+    def __repr__(self) -> str:
+        changed = [f"{f.name}={getattr(self, f.name)!r}" for f in fields(self)
+                   if getattr(self, f.name) != f.default]
+        return f"{type(self).__name__}({', '.join(changed)})"
+
+
+def _specs_from_annotations(cls):
+    """``[(name, Spec)]`` of a class body's ``option(...)`` fields, before the dataclass decorator runs."""
+    out = []
+    for name in getattr(cls, "__annotations__", {}):
+        value = cls.__dict__.get(name)
+        spec = getattr(value, "metadata", {}).get("spec") if value is not None else None
+        if spec is not None:
+            out.append((name, spec))
+    return out
+
+
+def flag_of(name: str, spec: Spec) -> str:
+    """The CLI flag of an option (``--max-edge`` for ``max_edge``, unless the spec names one)."""
+    return spec.flag or "--" + name.replace("_", "-")
+
+
+def _dest(flag: str) -> str:
+    return flag.lstrip("-").replace("-", "_")
+
+
+def add_arguments(parser, record: type, *, skip: tuple = ()) -> None:
+    """Add a flag to an ``argparse`` parser for every option of ``record`` (an :class:`Options` class).
+
+    A flag another record has already added (``--units``) is kept once.  The
+    parser does only the text-to-value step; the values are checked when the
+    record is made (:func:`from_arguments`), by the same code as the API's.
+    """
+    import argparse
+
+    for f in fields(record):
+        spec = f.metadata.get("spec")
+        if spec is None or f.name in skip:
+            continue
+        flag = flag_of(f.name, spec)
+        if any(flag in action.option_strings for action in parser._actions):
+            continue
+        text = spec.help.replace("%", "%%")
+        if isinstance(f.default, bool):
+            if f.default:
+                flag = spec.flag or "--no-" + f.name.replace("_", "-")
+                parser.add_argument(flag, dest=_dest(flag), action="store_true", help=text)
+            else:
+                parser.add_argument(flag, dest=_dest(flag), action="store_true", help=text)
+            continue
+        kind = spec.parse or (int if spec.integer else float if spec.choices is None and (
+            spec.low is not None or spec.high is not None or is_number(f.default)) else str)
+        default = None if spec.repeat else f.default
+        default = default.value if isinstance(default, Enum) else default
+        parser.add_argument(flag, dest=_dest(flag), type=kind, default=default, choices=spec.choices,
+                            action="append" if spec.repeat else "store", metavar=spec.metavar,
+                            help=text + ("" if default in (None, "") else f" (default {default})"))
+    del argparse
+
+
+def from_arguments(record: type, args, *, name: str | None = None, **extra):
+    """The ``record`` (an :class:`Options` class) from parsed ``args`` (see :func:`add_arguments`), plus ``extra``."""
+    values = {}
+    for f in fields(record):
+        spec = f.metadata.get("spec")
+        if spec is None or f.name in extra:
+            continue
+        if isinstance(f.default, bool) and f.default and not spec.flag:
+            values[f.name] = not getattr(args, _dest("--no-" + f.name.replace("_", "-")))
+        else:
+            value = getattr(args, _dest(flag_of(f.name, spec)))
+            if not (spec.repeat and value is None):
+                values[f.name] = value
+    values.update(extra)
+    return record.of(None, values, name=name)
+
+
+def cli_flags(record: type) -> dict:
+    """``{option name: CLI flag}`` for every option of ``record`` (what :func:`add_arguments` adds)."""
+    out = {}
+    for f in fields(record):
+        spec = f.metadata.get("spec")
+        if spec is not None:
+            bool_true = isinstance(f.default, bool) and f.default and not spec.flag
+            out[f.name] = "--no-" + f.name.replace("_", "-") if bool_true else flag_of(f.name, spec)
+    return out
