@@ -47,7 +47,7 @@ def models():
 
 def starts(v, f, conn):
     """The four starting layouts, each one-to-one."""
-    free = patterns.flatten_mesh(v, f, tolerance=1e-9, max_iterations=5000)
+    free = patterns.flatten_mesh(v, f, energy_tolerance=1e-9, max_iterations=5000)
     out = {"free optimum": (free.uv, 0.0), "greedy": (patterns.flatten_mesh(v, f, method="isometric").uv, 0.0)}
     for name, make in (("lscm", lscm), ("tutte", tutte_embedding)):
         s = make(v, f, conn)

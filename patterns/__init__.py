@@ -12,7 +12,7 @@ The public API, all importable from the top level::
     result.overlap.one_to_one, result.distortion.strain_rms
 """
 
-from .audit import Code, Finding, PanelReport, Report, SeamReport, Severity, check
+from .audit import CheckOptions, Code, Finding, PanelReport, Report, SeamReport, Severity, check
 from .cut import Cut, cut_to_disk
 from .errors import (
     CadError,
@@ -24,39 +24,47 @@ from .errors import (
     PatternsError,
 )
 from .export import heat_map, preview_dxf
-from .flattening import METHODS, Flattening, flatten, flatten_mesh
+from .export.dxf import DxfOptions
+from .flattening import METHODS, Flattening, FlattenOptions, flatten, flatten_mesh
 from .flattening.energy import ENERGIES
 from .flattening.seams import Ease, SeamLengths
 from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
-from .model import Model, Panel, Seam, Surface, SurfaceKind
+from .model import Bookkeeping, Model, Panel, Seam, Surface, SurfaceKind
 from .nesting import Layout, layout
 from .pattern import FlatPanel, FlatSeam, Pattern
 from .predicates import Overlap, overlap_verdict
-from .reading import load, read_cad, read_mesh
-from .tessellate import mesh_shape, tessellate_face
+from .reading import LoadOptions, load, read_cad, read_mesh
+from .tessellate import MeshingOptions, mesh_shape, tessellate_face
+from .units import Unit
 
 __version__ = "0.1.0"
 
 __all__ = [
     "ENERGIES",
     "METHODS",
+    "Bookkeeping",
     "CadError",
+    "CheckOptions",
     "Code",
     "Connectivity",
     "Cut",
     "Distortion",
+    "DxfOptions",
     "Ease",
     "ExportError",
     "Finding",
     "FlatPanel",
     "FlatSeam",
     "FlattenError",
+    "FlattenOptions",
     "Flattening",
     "InputError",
     "Layout",
     "LayoutError",
+    "LoadOptions",
     "MeshTopologyError",
+    "MeshingOptions",
     "Model",
     "Overlap",
     "Panel",
@@ -71,6 +79,7 @@ __all__ = [
     "StrainStats",
     "Surface",
     "SurfaceKind",
+    "Unit",
     "__version__",
     "check",
     "cut_to_disk",

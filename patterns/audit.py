@@ -16,11 +16,11 @@ from .errors import InputError
 from .files import atomic_output
 from .measure import edge_strain, folded_faces, strain_stats
 from .mesh import _readonly
-from .options import check_number
+from .options import Options, option
 from .pattern import Pattern
 from .predicates import Overlap, boundary_crossings, crossing_segments, overlap_verdict
 
-__all__ = ["REPORT_SCHEMA", "Code", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
+__all__ = ["REPORT_SCHEMA", "CheckOptions", "Code", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
            "boundary_crossings", "check", "crossing_segments", "overlap_verdict"]
 
 
@@ -229,7 +229,19 @@ class Report:
         return "\n".join(lines)
 
 
-def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float | None = None) -> Report:
+@dataclass(frozen=True, repr=False)
+class CheckOptions(Options):
+    """The limits a pattern is checked against (:func:`check`, ``patterns flatten/check --max-strain``)."""
+
+    max_strain: float | None = option(None, "largest acceptable triangle strain, a ratio (0.03 = 3 %); triangles "
+                                            "above it are findings (the command line then exits with 1)",
+                                      low=0, low_open=True, optional=True, metavar="R")
+    max_seam_mismatch: float | None = option(None, "largest acceptable difference of a seam's two flat lengths, "
+                                                   "mm (above it the command line exits with 1)",
+                                             low=0, low_open=True, optional=True, metavar="MM")
+
+
+def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
     """Check a pattern before cutting: overlaps, strain, seams.
 
     Never raises on geometry: every problem becomes a :class:`Finding` with
@@ -238,12 +250,11 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
     Parameters
     ----------
     pattern : patterns.Pattern
-    max_strain : float, optional
-        Largest acceptable triangle strain (0.03 = 3 %); triangles above it
-        are reported, with the share of area they cover.
-    max_seam_mismatch : float, optional
-        Largest acceptable difference between the two flat lengths of a seam,
-        mm.
+    options : CheckOptions, optional
+        The limits as a record; keywords (``max_strain``: largest acceptable
+        triangle strain, 0.03 = 3 %, triangles above it are reported with the
+        share of area they cover; ``max_seam_mismatch``: largest acceptable
+        difference between the two flat lengths of a seam, mm) go over it.
 
     Returns
     -------
@@ -263,11 +274,8 @@ def check(pattern, *, max_strain: float | None = None, max_seam_mismatch: float 
     """
     if not isinstance(pattern, Pattern):
         raise InputError(f"check() takes a patterns.Pattern (from patterns.flatten), got {type(pattern).__name__}")
-    if max_strain is not None:
-        max_strain = check_number(max_strain, "max_strain", low=0, low_open=True, name=pattern.name)
-    if max_seam_mismatch is not None:
-        max_seam_mismatch = check_number(max_seam_mismatch, "max_seam_mismatch", low=0, low_open=True,
-                                         name=pattern.name)
+    opts = CheckOptions.of(options, keywords, name=pattern.name)
+    max_strain, max_seam_mismatch = opts.max_strain, opts.max_seam_mismatch
     findings = []
     panel_reports = []
     for flat in pattern.panels:

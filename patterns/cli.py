@@ -63,34 +63,13 @@ class Progress:
             self.stream.flush()
 
 
-def _direction(text: str):
-    try:
-        values = [float(x) for x in text.split(",")]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected X,Y,Z numbers, got {text!r}") from None
-    if len(values) != 3:
-        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}")
-    return tuple(values)
-
-
-def _ease(text: str):
-    """``SEAM:PANEL:AMOUNT`` (mm, or a percentage with %) as a :class:`patterns.Ease`."""
-    from .flattening.seams import Ease
-
-    try:
-        seam, panel, amount = text.split(":")
-        if amount.endswith("%"):
-            return Ease(int(seam), panel, ratio=float(amount[:-1]) / 100.0)
-        return Ease(int(seam), panel, mm=float(amount))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected SEAM:PANEL:MM or SEAM:PANEL:PERCENT%, got {text!r}") from None
-
-
 def _parser() -> argparse.ArgumentParser:
-    from . import METHODS, __version__
-    from .export.dxf import MACHINE_VERSIONS, PROFILES, UNITS
-    from .flattening.energy import ENERGIES
-    from .flattening.seams import SeamLengths
+    from . import __version__
+    from .audit import CheckOptions
+    from .export.dxf import DxfOptions
+    from .flattening import FlattenOptions
+    from .options import add_arguments
+    from .reading import LoadOptions
 
     parser = argparse.ArgumentParser(
         prog="patterns", description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns."
@@ -99,65 +78,38 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    def loading(p):
-        p.add_argument("input", type=Path,
-                       help="CAD file (.step .stp .brep .iges .igs) or mesh file (.stl .obj .ply .off .3mf)")
-        p.add_argument("--max-edge", type=float, default=None, help="CAD: target triangle edge length, mm")
-        p.add_argument("--tolerance", type=float, default=0.05, help="CAD: chordal tolerance, mm (default 0.05)")
-        p.add_argument("--units", choices=tuple(UNITS), default="mm",
-                       help="mesh files: unit of the coordinates (CAD files carry their own); also the DXF's unit")
+    # Every option flag below is made from the records the API validates with
+    # (patterns.options): a new option there is a new flag here.
+    def loading(p, *, positional=True):
+        if positional:
+            p.add_argument("input", type=Path,
+                           help="CAD file (.step .stp .brep .iges .igs) or mesh file (.stl .obj .ply .off .3mf)")
+        add_arguments(p.add_argument_group("loading"), LoadOptions)
 
     def flattening(p):
-        p.add_argument("--method", choices=METHODS, default="relaxed", help="flattening method (default relaxed)")
-        p.add_argument("--max-iterations", type=int, default=500, help="relaxation iterations at most (default 500)")
-        p.add_argument("--energy", choices=ENERGIES, default="auto",
-                       help="relaxed: the distortion minimised (default auto: ARAP, the squared principal strains, "
-                            "or the hybrid where ARAP would press triangles flat)")
-        p.add_argument("--seams", choices=tuple(m.value for m in SeamLengths), default="true",
-                       help="relaxed: hold every seam edge at its 3D length (true, default), each seam's total "
-                            "length only (total), or nothing (free)")
-        p.add_argument("--ease", type=_ease, action="append", default=None, metavar="SEAM:PANEL:AMOUNT",
-                       help="deliberate extra length on one side of a seam: mm, or %% of its length (repeatable)")
-        p.add_argument("--min-stretch", type=float, default=None, metavar="R",
-                       help="relaxed: keep every triangle at least this fraction of its size in every direction, "
-                            "0..1")
-        p.add_argument("--thickness", type=float, default=0.0, help="sheet thickness, mm: develop the neutral surface")
-        p.add_argument("--k-factor", type=float, default=0.5, help="neutral surface from the inside, 0..1 (default 0.5)")
-        p.add_argument("--reference", choices=("inside", "outside", "mid"), default="mid",
-                       help="which skin of the sheet the model shows (default mid)")
-        p.add_argument("--grain", type=_direction, default=None, metavar="X,Y,Z",
-                       help="3D direction to point along +Y on every panel (fabric grain, rolling direction)")
+        add_arguments(p.add_argument_group("flattening"), FlattenOptions)
 
-    def checking(p):
-        p.add_argument("--max-strain", type=float, default=None,
-                       help="largest acceptable strain, a ratio (0.03 = 3 %%); above it the exit code is 1")
-        p.add_argument("--max-seam-mismatch", type=float, default=None,
-                       help="largest acceptable difference of a seam's two flat lengths, mm; above it exit code 1")
-        p.add_argument("--report", type=Path, default=None, help="write the JSON report here")
+    def checking(p, *, report=True):
+        group = p.add_argument_group("checking")
+        add_arguments(group, CheckOptions)
+        if report:
+            group.add_argument("--report", type=Path, default=None, help="write the JSON report here")
 
     def output(p):
-        p.add_argument("--profile", choices=PROFILES, default="machine",
-                       help="DXF dialect: machine (laser, plasma, knife) or astm (garment CAD); default machine")
-        p.add_argument("--seam-allowance", type=float, default=0.0, help="seam allowance on every edge, mm")
-        p.add_argument("--dxf-version", choices=tuple(MACHINE_VERSIONS), default=None,
-                       help="machine profile: DXF version (default R2000)")
-        p.add_argument("--arcs", action="store_true", help="machine profile: cut contours as arcs and lines")
-        p.add_argument("--bend-spacing", type=float, default=None,
-                       help="draw the rulings of cylinders and cones about this far apart (mm) on BEND")
-        p.add_argument("--notch-spacing", type=float, default=None,
-                       help="matching notches along every seam every this many mm of 3D length (default: ends)")
-        p.add_argument("--roll-width", type=float, default=None,
-                       help="nest the panels on a roll this wide (mm) before writing; grain kept along the roll")
+        group = p.add_argument_group("DXF output")
+        add_arguments(group, DxfOptions, skip=("units",))  # --units: one flag with loading's
+        group.add_argument("--roll-width", type=float, default=None, metavar="MM",
+                           help="nest the panels on a roll this wide (mm) before writing; grain kept along the roll")
 
     flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, or .obj for one panel)")
-    loading(flat)
     flat.add_argument("-o", "--output", type=Path, required=True,
                       help="output: .dxf (the pattern for a cutter) or .obj (the flat mesh of a one-panel part)")
+    flat.add_argument("--preview", type=Path, default=None, help="render the written DXF at 1:1 (.png or .svg)")
+    flat.add_argument("--heat-map", type=Path, default=None, help="strain heat map (.png or .svg)")
+    loading(flat)
     flattening(flat)
     checking(flat)
     output(flat)
-    flat.add_argument("--preview", type=Path, default=None, help="render the written DXF at 1:1 (.png or .svg)")
-    flat.add_argument("--heat-map", type=Path, default=None, help="strain heat map (.png or .svg)")
 
     chk = sub.add_parser("check", help="flatten a part and report strain, seams and overlaps (no pattern file)")
     loading(chk)
@@ -176,13 +128,28 @@ def _parser() -> argparse.ArgumentParser:
     batch.add_argument("--jobs", type=int, default=None, help="parallel processes (default: the CPU count)")
     batch.add_argument("--scheduler", default=None,
                        help="run on a Dask distributed cluster at this address (needs patterns[dask])")
-    batch.add_argument("--max-edge", type=float, default=None, help="CAD: target triangle edge length, mm")
-    batch.add_argument("--tolerance", type=float, default=0.05, help="CAD: chordal tolerance, mm (default 0.05)")
+    loading(batch, positional=False)
     flattening(batch)
-    batch.add_argument("--max-strain", type=float, default=None, help="largest acceptable strain (ratio)")
-    batch.add_argument("--max-seam-mismatch", type=float, default=None, help="largest acceptable seam mismatch, mm")
+    checking(batch, report=False)
     output(batch)
     return parser
+
+
+def _records(args, name=None):
+    """The option records (load, flatten, check, DXF) from parsed flags: each value checked as the API checks it."""
+    from .audit import CheckOptions
+    from .export.dxf import DxfOptions
+    from .flattening import FlattenOptions
+    from .options import from_arguments
+    from .reading import LoadOptions
+
+    records = {"load": from_arguments(LoadOptions, args, name=name)}
+    if hasattr(args, "method"):
+        records["flatten"] = from_arguments(FlattenOptions, args, name=name)
+        records["check"] = from_arguments(CheckOptions, args, name=name)
+    if hasattr(args, "profile"):
+        records["dxf"] = from_arguments(DxfOptions, args, name=name)
+    return records
 
 
 # --------------------------------------------------------------------------- #
@@ -190,36 +157,29 @@ def _parser() -> argparse.ArgumentParser:
 # --------------------------------------------------------------------------- #
 
 
-def _load(args):
-    from .reading import CAD_SUFFIXES, MESH_SUFFIXES, load, mesh_model, read_mesh
+def _load(path, records):
+    from .reading import load
 
-    path = args.input
-    suffix = path.suffix.lower()
-    if suffix in MESH_SUFFIXES and args.units != "mm":
-        scale = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}[args.units]
-        mesh = read_mesh(path)
-        return mesh_model(mesh.vertices * scale, mesh.faces, name=path.name)
-    if suffix in CAD_SUFFIXES or suffix in MESH_SUFFIXES:
-        return load(path, max_edge=args.max_edge, tolerance=args.tolerance)
-    return load(path)  # raises the one-line error for a missing file or unknown type
+    model = load(path, records["load"])
+    if model.bookkeeping.welded or model.bookkeeping.unused or model.bookkeeping.cuts:
+        print(f"{path}: {model.bookkeeping}")
+    return model
 
 
-def _flatten(model, args):
+def _flatten(model, records):
     from .flattening import flatten
 
     progress = Progress(f"flattening {len(model.panels)} panels")
     try:
-        return flatten(model, method=args.method, max_iterations=args.max_iterations, thickness=args.thickness,
-                       k_factor=args.k_factor, reference=args.reference, grain=args.grain, energy=args.energy,
-                       seams=args.seams, ease=args.ease, min_stretch=args.min_stretch, progress=progress)
+        return flatten(model, records["flatten"], progress=progress)
     finally:
         progress.close()
 
 
-def _check(pattern, args):
+def _check(pattern, records):
     from .audit import check
 
-    return check(pattern, max_strain=args.max_strain, max_seam_mismatch=args.max_seam_mismatch)
+    return check(pattern, records["check"])
 
 
 def _print_panels(report, units_note=""):
@@ -263,27 +223,26 @@ def _cmd_flatten(args) -> int:
     for label, value in (("--preview", args.preview), ("--heat-map", args.heat_map)):
         if value is not None and value.suffix.lower() not in (".png", ".svg"):
             raise InputError(f"{value}: {label} writes .png or .svg")
+    records = _records(args, name=str(args.input))  # every option checked before any long work
     start = time.perf_counter()
-    model = _load(args)
+    model = _load(args.input, records)
     loaded = time.perf_counter() - start
     if suffix == ".obj" and len(model.panels) != 1:
         raise InputError(f"{args.input}: {len(model.panels)} panels; a flat .obj holds one, write a .dxf")
     print(f"{args.input}: {len(model.panels)} panels, {len(model.seams)} seams "
           f"(target edge {model.max_edge:.3g} mm), loaded in {loaded:.2f} s")
     start = time.perf_counter()
-    pattern = _flatten(model, args)
-    print(f"flattened ({args.method}) in {time.perf_counter() - start:.2f} s")
+    pattern = _flatten(model, records)
+    print(f"flattened ({records['flatten'].method}) in {time.perf_counter() - start:.2f} s")
     if args.roll_width is not None:
-        nest = pattern.layout(width=args.roll_width, margin=args.seam_allowance)
+        nest = pattern.layout(width=args.roll_width, margin=_margin(records["dxf"]))
         pattern = nest.pattern
         print(f"nested on a {args.roll_width:g} mm roll: {nest.length:.1f} mm used, efficiency {nest.efficiency:.1%}")
-    report = _check(pattern, args)
+    report = _check(pattern, records)
     _print_panels(report)
     if suffix == ".dxf":
-        pattern.to_dxf(args.output, profile=args.profile, seam_allowance=args.seam_allowance, units=args.units,
-                       version=args.dxf_version, arcs=args.arcs, bend_spacing=args.bend_spacing,
-                       notch_spacing=args.notch_spacing)
-        print(f"wrote {args.output} ({args.profile} profile, {args.units})")
+        pattern.to_dxf(args.output, records["dxf"])
+        print(f"wrote {args.output} ({records['dxf'].profile} profile, {records['dxf'].units})")
     else:
         from .export import write_flat_obj
 
@@ -306,10 +265,17 @@ def _cmd_flatten(args) -> int:
     return _verdict(report)
 
 
+def _margin(dxf) -> float:
+    """The largest seam allowance of the DXF options (the nesting margin), mm."""
+    allowance = dxf.seam_allowance
+    return max(allowance.values(), default=0.0) if isinstance(allowance, dict) else allowance
+
+
 def _cmd_check(args) -> int:
-    model = _load(args)
-    pattern = _flatten(model, args)
-    report = _check(pattern, args)
+    records = _records(args, name=str(args.input))
+    model = _load(args.input, records)
+    pattern = _flatten(model, records)
+    report = _check(pattern, records)
     _print_panels(report)
     if args.report is not None:
         report.to_json(args.report)
@@ -318,7 +284,7 @@ def _cmd_check(args) -> int:
 
 
 def _cmd_info(args) -> int:
-    model = _load(args)
+    model = _load(args.input, _records(args, name=str(args.input)))
     print(f"{args.input}: {len(model.panels)} panels, {len(model.seams)} seams, target edge {model.max_edge:.3g} mm")
     rows = [("panel", "CAD faces", "vertices", "triangles", "outline loops", "area mm2")]
     for p in model.panels:
@@ -372,31 +338,23 @@ def _cmd_demo(args) -> int:
     return EXIT_OK
 
 
-def _batch_one(path: str, out: str, options: dict) -> dict:
+def _batch_one(path: str, out: str, records: dict, roll_width) -> dict:
     """Flatten one file into ``out``: a row of the batch summary.  Never raises."""
-    from types import SimpleNamespace
-
     from .audit import check
     from .flattening import flatten
+    from .reading import load
 
     start = time.perf_counter()
     row = {"file": Path(path).name, "panels": None, "seams": None, "strain_rms": None, "strain_max": None,
            "status": "", "ok": False, "error": None, "seconds": None}
     try:
-        args = SimpleNamespace(input=Path(path), max_edge=options["max_edge"], tolerance=options["tolerance"],
-                               units="mm")
-        model = _load(args)
-        pattern = flatten(model, method=options["method"], max_iterations=options["max_iterations"],
-                          thickness=options["thickness"], k_factor=options["k_factor"], reference=options["reference"],
-                          grain=options["grain"], min_stretch=options["min_stretch"], energy=options["energy"],
-                          seams=options["seams"], ease=options["ease"])
-        if options["roll_width"] is not None:
-            pattern = pattern.layout(width=options["roll_width"], margin=options["seam_allowance"]).pattern
-        report = check(pattern, max_strain=options["max_strain"], max_seam_mismatch=options["max_seam_mismatch"])
+        model = load(path, records["load"])
+        pattern = flatten(model, records["flatten"])
+        if roll_width is not None:
+            pattern = pattern.layout(width=roll_width, margin=_margin(records["dxf"])).pattern
+        report = check(pattern, records["check"])
         stem = Path(out) / Path(path).stem
-        pattern.to_dxf(stem.with_suffix(".dxf"), profile=options["profile"],
-                       seam_allowance=options["seam_allowance"], version=options["dxf_version"], arcs=options["arcs"],
-                       bend_spacing=options["bend_spacing"], notch_spacing=options["notch_spacing"])
+        pattern.to_dxf(stem.with_suffix(".dxf"), records["dxf"])
         report.to_json(stem.with_suffix(".json"))
         row.update(panels=len(model.panels), seams=len(model.seams),
                    strain_rms=max(p.strain_rms for p in report.panels),
@@ -415,6 +373,7 @@ def _cmd_batch(args) -> int:
 
     from .reading import CAD_SUFFIXES, MESH_SUFFIXES
 
+    records = _records(args)  # every option checked before any file is read
     if not args.folder.is_dir():
         raise InputError(f"{args.folder}: no such folder")
     if args.jobs is not None and args.jobs < 1:
@@ -426,11 +385,6 @@ def _cmd_batch(args) -> int:
         args.output.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InputError(f"{args.output}: cannot create the output folder ({exc.strerror})") from None
-    options = {k: getattr(args, k) for k in ("max_edge", "tolerance", "method", "max_iterations", "max_strain",
-                                              "max_seam_mismatch", "profile", "seam_allowance", "dxf_version",
-                                              "thickness", "k_factor", "reference", "arcs", "bend_spacing",
-                                              "grain", "notch_spacing", "roll_width", "min_stretch", "energy",
-                                              "seams", "ease")}
     progress = Progress(f"batch of {len(files)} files")
     rows = []
     if args.scheduler:
@@ -444,7 +398,7 @@ def _cmd_batch(args) -> int:
         except (OSError, TimeoutError) as exc:
             raise InputError(f"{args.scheduler}: cannot reach the Dask scheduler ({exc})") from None
         with client:
-            futures = [client.submit(_batch_one, str(p), str(args.output), options, pure=False) for p in files]
+            futures = [client.submit(_batch_one, str(p), str(args.output), records, args.roll_width, pure=False) for p in files]
             for future in dask_completed(futures):
                 rows.append(future.result())
                 progress(len(rows), len(files))
@@ -452,7 +406,7 @@ def _cmd_batch(args) -> int:
     else:
         jobs = args.jobs or os.cpu_count() or 1
         with ProcessPoolExecutor(max_workers=min(jobs, len(files))) as pool:
-            futures = [pool.submit(_batch_one, str(p), str(args.output), options) for p in files]
+            futures = [pool.submit(_batch_one, str(p), str(args.output), records, args.roll_width) for p in files]
             for future in as_completed(futures):
                 rows.append(future.result())
                 progress(len(rows), len(files))

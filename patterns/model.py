@@ -14,7 +14,7 @@ import numpy as np
 
 from .mesh import face_areas
 
-__all__ = ["Model", "Panel", "Seam", "Surface", "SurfaceKind"]
+__all__ = ["Bookkeeping", "Model", "Panel", "Seam", "Surface", "SurfaceKind"]
 
 
 def _own(array, dtype=None) -> np.ndarray:
@@ -162,6 +162,34 @@ class Seam:
         return self.panels[0] == self.panels[1]
 
 
+@dataclass(frozen=True)
+class Bookkeeping:
+    """What loading did to the input, so that nothing happens behind the user's back.
+
+    Attributes
+    ----------
+    welded : int
+        Vertices merged into another at exactly the same coordinates (mesh
+        files: STL by default, see :func:`patterns.reading.read_mesh`).
+    unused : int
+        Vertices no face used, dropped.
+    cuts : int
+        Cuts made to open a closed or tube-like piece into a disk (seams with
+        no CAD edge; each is a seam of the model).
+    """
+
+    welded: int = 0
+    unused: int = 0
+    cuts: int = 0
+
+    def __str__(self) -> str:
+        parts = [f"{self.welded} vertices welded" if self.welded else "",
+                 f"{self.unused} unused vertices dropped" if self.unused else "",
+                 f"{self.cuts} cut{'s' if self.cuts != 1 else ''} made to open tubes or closed pieces"
+                 if self.cuts else ""]
+        return "; ".join(p for p in parts if p) or "nothing welded, dropped or cut"
+
+
 @dataclass(frozen=True, eq=False)
 class Model:
     """Panels and seams of one part, in millimetres.
@@ -175,12 +203,15 @@ class Model:
     max_edge : float, mm
         The target edge length the panels were meshed to (for mesh files, the
         longest edge found).
+    bookkeeping : Bookkeeping
+        What loading did: vertices welded, unused vertices dropped, cuts made.
     """
 
     name: str
     panels: tuple
     seams: tuple
     max_edge: float
+    bookkeeping: Bookkeeping = Bookkeeping()
 
     def seams_of(self, panel: int) -> tuple:
         """The seams with ``panel`` on either side."""

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numbers
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields, is_dataclass, replace
 from enum import Enum
 from typing import Any
 
@@ -169,7 +169,8 @@ class Options:
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         cls.__doc__ = (cls.__doc__ or "").rstrip() + "\n\n    Attributes\n    ----------\n" + "".join(
-            f"    {name}\n        {spec.help}\n" for name, spec in _specs_from_annotations(cls))
+            f"    {name} : {_kind(spec, default)}\n        {spec.help}.\n"
+            for name, spec, default in _specs_from_annotations(cls))
 
     def __post_init__(self):
         for f in fields(self):
@@ -200,6 +201,15 @@ class Options:
         except InputError as exc:
             raise InputError(f"{prefix}{exc}") from None
 
+    @classmethod
+    def checked(cls, option: str, value, *, where: str | None = None):
+        """One option's value checked by its declaration (for a function that takes it as a keyword), or InputError."""
+        declared = next(f for f in fields(cls) if f.name == option)
+        try:
+            return declared.metadata["spec"].validate(value, option, declared.default)
+        except InputError as exc:
+            raise InputError(f"{where}: {exc}" if where else str(exc)) from None
+
     def __repr__(self) -> str:
         changed = [f"{f.name}={getattr(self, f.name)!r}" for f in fields(self)
                    if getattr(self, f.name) != f.default]
@@ -207,14 +217,36 @@ class Options:
 
 
 def _specs_from_annotations(cls):
-    """``[(name, Spec)]`` of a class body's ``option(...)`` fields, before the dataclass decorator runs."""
-    out = []
-    for name in getattr(cls, "__annotations__", {}):
+    """``[(name, Spec, default)]`` of a record's options: its bases' (already dataclasses) and its own
+    ``option(...)`` fields (the dataclass decorator has not run yet)."""
+    out, seen = [], set()
+    for base in reversed(cls.__mro__[1:]):
+        if is_dataclass(base):
+            for f in fields(base):
+                if "spec" in f.metadata and f.name not in seen:
+                    seen.add(f.name)
+                    out.append((f.name, f.metadata["spec"], f.default))
+    for name in cls.__dict__.get("__annotations__", {}):
         value = cls.__dict__.get(name)
         spec = getattr(value, "metadata", {}).get("spec") if value is not None else None
-        if spec is not None:
-            out.append((name, spec))
+        if spec is not None and name not in seen:
+            out.append((name, spec, value.default))
     return out
+
+
+def _kind(spec: Spec, default) -> str:
+    """The numpydoc type line of an option: ``{"mm", "in"}, default "mm"``, ``float, optional``, ..."""
+    if spec.choices is not None:
+        kind = "{" + ", ".join(repr(c) for c in spec.choices) + "}"
+    elif isinstance(default, bool):
+        kind = "bool"
+    elif spec.integer:
+        kind = "int"
+    elif spec.low is not None or spec.high is not None or is_number(default):
+        kind = "float"
+    else:
+        kind = "object"
+    return f"{kind}, optional" if default is None else f"{kind}, default {default!r}"
 
 
 def flag_of(name: str, spec: Spec) -> str:

@@ -269,60 +269,33 @@ class Pattern:
         """True when no panel overlaps itself."""
         return all(p.flattening.one_to_one for p in self.panels)
 
-    def to_dxf(self, path, *, profile: str = "machine", seam_allowance=0.0, units: str = "mm",
-               version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
-               gap: float | None = None, arcs: bool = False, arc_tolerance: float = 0.01,
-               bend_spacing: float | None = None, notch_spacing: float | None = None,
-               notch_style: str = "slit", seam_corners: str = "mitre") -> None:
+    def to_dxf(self, path, options=None, **keywords) -> None:
         """Write the pattern as a DXF file for a cutter (atomically).
 
         Parameters
         ----------
         path : str or Path
-        profile : {"machine", "astm"}
-            ``"machine"`` (laser, plasma, waterjet, knife plotter): layers CUT,
-            SEW, NOTCH, GRAIN, BEND, LABEL (and STRAIN); every cut contour one
-            closed polyline.  ``"astm"`` (garment CAD: Gerber, Lectra, Optitex,
-            CLO, Valentina): ASTM D6673 R12, one block per piece.  See docs/dxf.md.
-        seam_allowance : float or mapping
-            Added outside the seam line, mm: one number for every edge, or
-            ``{seam id: mm, ..., None: mm for every other edge}``.  The cut line
-            is then the offset outline (mitred corners) and the seam line goes
-            on SEW (ASTM layer 14).
-        units : {"mm", "cm", "m", "in"}
-            Machine profile only (ASTM is mm).
-        version : str, optional
-            Machine profile: ``"R12"``, ``"R2000"`` (default), ``"R2004"``, ...
-        strain_layer : bool
-            Machine profile: add the strain heat map as filled triangles on
-            layer STRAIN (true colour from R2004).
-        text_height : float, optional
-            mm; default 3 % of each panel's size, 2-12 mm.
-        gap : float, optional
-            Space between panels when the pattern is not laid out, mm.
-        arcs : bool
-            Machine profile: write each cut contour with arcs and lines fitted
-            within ``arc_tolerance`` (one closed polyline with bulges).
-        arc_tolerance : float
-            mm (default 0.01).
-        bend_spacing : float, optional
-            Draw the rulings of exactly developed cylinders and cones about this
-            far apart (mm) on BEND with their bend angles (ASTM: layer 8).
-        notch_spacing : float, optional
-            Matching notches along every seam every this many mm of *3D* seam
-            length (and at both ends), on both panels: the pieces line up when
-            sewn even where the flat lengths differ.  Default: at the ends only.
-        notch_style : {"slit", "v"}
-        seam_corners : {"mitre", "square"}
-            Corners of the seam allowance: offset lines meeting at a point, or
-            each side's allowance run straight on past the corner (squared).
-        """
-        from .export.dxf import write_pattern_dxf
+        options : patterns.DxfOptions, optional
+            The options as a record; keyword arguments (any field of
+            :class:`~patterns.DxfOptions`: ``profile``, ``seam_allowance``,
+            ``units``, ``version``, ``strain_layer``, ``text_height``, ``gap``,
+            ``arcs``, ``arc_tolerance``, ``bend_spacing``, ``notch_spacing``,
+            ``notch_style``, ``seam_corners``) go over it.  ``profile="machine"``
+            (default; laser, plasma, waterjet, knife plotter) writes layers CUT,
+            SEW, NOTCH, GRAIN, BEND, LABEL (and STRAIN), every cut contour one
+            closed polyline; ``"astm"`` (garment CAD) writes ASTM D6673 R12, one
+            block per piece.  See docs/dxf.md.
 
-        write_pattern_dxf(self, path, profile=profile, seam_allowance=seam_allowance, units=units, version=version,
-                          strain_layer=strain_layer, text_height=text_height, gap=gap, arcs=arcs,
-                          arc_tolerance=arc_tolerance, bend_spacing=bend_spacing, notch_spacing=notch_spacing,
-                          notch_style=notch_style, seam_corners=seam_corners)
+        Raises
+        ------
+        InputError
+            An unknown option or a bad value (nothing is written).
+        ExportError
+            The file cannot be written.
+        """
+        from .export.dxf import write_pattern_dxf  # ezdxf is imported only when a DXF is written
+
+        write_pattern_dxf(self, path, options, **keywords)
 
     def layout(self, *, width: float, gap: float = 10.0, margin: float = 0.0, allow_rotation: bool = True,
                respect_grain: bool = True, step: float | None = None):

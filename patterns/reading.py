@@ -19,7 +19,7 @@ count is reported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -27,10 +27,12 @@ import numpy as np
 from .cut import cut_to_disk, pieces
 from .errors import CadError, InputError
 from .mesh import as_mesh_arrays, drop_unused, unique_ints, validate_mesh
-from .model import Model, Panel, Seam
-from .tessellate import mesh_shape
+from .model import Bookkeeping, Model, Panel, Seam
+from .options import option
+from .tessellate import MeshingOptions, mesh_shape
+from .units import UNIT_NAMES, Unit
 
-__all__ = ["CAD_SUFFIXES", "MESH_SUFFIXES", "MeshFile", "drop_unused", "load", "mesh_model", "read_cad", "read_mesh", "weld"]
+__all__ = ["CAD_SUFFIXES", "LoadOptions", "MESH_SUFFIXES", "MeshFile", "drop_unused", "load", "mesh_model", "read_cad", "read_mesh", "weld"]
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".3mf")
 """File suffixes :func:`read_mesh` reads."""
@@ -219,8 +221,33 @@ def read_cad(path):
     return shape
 
 
-def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max_edge: float | None = None,
-         faces=None, sew: bool = True, weld_vertices: bool | None = None):
+def _weld(value, option):
+    if value is None or isinstance(value, (bool, np.bool_)):
+        return None if value is None else bool(value)
+    raise InputError(f"{option} must be True, False or None, got {value!r}")
+
+
+def _yes_no(text: str) -> bool:
+    """``"yes"``/``"no"`` (command line) as a bool."""
+    if text not in ("yes", "no"):
+        raise ValueError(f"expected yes or no, got {text!r}")
+    return text == "yes"
+
+
+@dataclass(frozen=True, repr=False)
+class LoadOptions(MeshingOptions):
+    """How a part is read (:func:`load`; ``patterns flatten``, ``check``, ``info``, ``batch``)."""
+
+    weld_vertices: bool | None = option(None, "mesh files: weld vertices at exactly the same coordinates (default: "
+                                              "STL files only, whose triangles store their corners apart; the "
+                                              "count is in Model.bookkeeping)", check=_weld, parse=_yes_no,
+                                        metavar="yes|no", optional=True)
+    units: str = option("mm", "mesh files: the unit of the coordinates, converted to mm (CAD files are read in "
+                              "mm whatever this says); on the command line also the unit of the DXF",
+                        choices=UNIT_NAMES)
+
+
+def load(source, options: LoadOptions | None = None, **keywords):
     """Load a part as panels joined by seams.
 
     Parameters
@@ -228,29 +255,21 @@ def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max
     source : str, Path or build123d shape
         A CAD file (.step/.stp, .brep, .iges/.igs), a mesh file (.stl, .obj,
         .ply, .off, .3mf), or a build123d ``Face``, ``Shell``, ``Solid``,
-        ``Compound`` or ``Part``.  Millimetres.
-    tolerance : float
-        CAD only: largest distance from the mesh to the true surface, mm (> 0).
-    angular_tolerance : float
-        CAD only: largest angle between the normals at the two ends of a mesh
-        edge, radians (> 0).
-    max_edge : float, optional
-        CAD only: target edge length, mm (> 0); default from the part's area
-        (about 4000 triangles, and at least about 1000 on every face).  Curved
-        faces and edges get shorter ones to meet the tolerances.
-    faces : mapping of str to list of int, optional
-        CAD only: groups of CAD faces (indices in ``shape.faces()`` order) to
-        cut as one panel each, e.g. ``{"front": [0, 1], "back": [2, 3]}``.
-    sew : bool
-        CAD only: sew faces that meet along an edge without sharing it (a file
-        of loose faces), so that the edge becomes a seam; see
-        :func:`patterns.tessellate.mesh_shape`.
-    weld_vertices : bool, optional
-        Mesh files only: see :func:`read_mesh`.
+        ``Compound`` or ``Part``.
+    options : LoadOptions, optional
+        The options as a record; keywords (any field of :class:`LoadOptions`)
+        go over it.  CAD: ``max_edge`` (mm), ``chord_tolerance`` (mm),
+        ``angular_tolerance`` (radians), ``panels`` (groups of CAD faces cut as
+        one panel each, ``{"front": [0, 1]}``), ``sew``; see
+        :func:`patterns.tessellate.mesh_shape`.  Mesh files:
+        ``weld_vertices`` (see :func:`read_mesh`) and ``units`` (the unit of
+        the file's coordinates; the model is in mm).
 
     Returns
     -------
     Model
+        In mm; :attr:`Model.bookkeeping` says what loading did (vertices
+        welded, unused vertices dropped, cuts made to open tubes).
 
     Raises
     ------
@@ -261,26 +280,30 @@ def load(source, *, tolerance: float = 0.05, angular_tolerance: float = 0.2, max
     MeshTopologyError
         A mesh piece that is non-manifold, inconsistently wound, or has handles.
     """
+    name = str(source) if isinstance(source, (str, Path)) else type(source).__name__
+    opts = LoadOptions.of(options, keywords, name=name)
+    meshing = {f.name: getattr(opts, f.name) for f in fields(MeshingOptions)}
     if isinstance(source, (str, Path)):
         path = Path(source)
         suffix = path.suffix.lower()
         if suffix in CAD_SUFFIXES:
-            if weld_vertices is not None:
+            if opts.weld_vertices is not None:
                 raise InputError(f"{path}: weld_vertices applies to mesh files only")
-            return mesh_shape(read_cad(path), max_edge=max_edge, tolerance=tolerance,
-                              angular_tolerance=angular_tolerance, faces=faces, sew=sew, name=path.name)
+            return mesh_shape(read_cad(path), name=path.name, **meshing)
         if suffix in MESH_SUFFIXES:
-            if faces is not None:
-                raise InputError(f"{path}: faces (groups of CAD faces) apply to CAD files only")
-            mesh = read_mesh(path, weld_vertices=weld_vertices)
-            return mesh_model(mesh.vertices, mesh.faces, name=path.name)
+            if opts.panels is not None:
+                raise InputError(f"{path}: panels (groups of CAD faces) apply to CAD files only")
+            mesh = read_mesh(path, weld_vertices=opts.weld_vertices)
+            scale = Unit(opts.units).mm
+            model = mesh_model(mesh.vertices * scale if scale != 1.0 else mesh.vertices, mesh.faces, name=path.name)
+            return replace(model, bookkeeping=replace(model.bookkeeping, welded=mesh.n_welded,
+                                                      unused=mesh.n_unused))
         if not path.exists():
             raise InputError(f"{path}: no such file")
         raise InputError(f"{path}: unknown file type {suffix or '(none)'!r}; expected a CAD file "
                          f"({', '.join(CAD_SUFFIXES)}) or a mesh file ({', '.join(MESH_SUFFIXES)})")
     if hasattr(source, "wrapped"):
-        return mesh_shape(source, max_edge=max_edge, tolerance=tolerance, angular_tolerance=angular_tolerance,
-                          faces=faces, sew=sew, name=type(source).__name__)
+        return mesh_shape(source, name=type(source).__name__, **meshing)
     raise InputError(f"cannot load a {type(source).__name__}: give a file path or a build123d shape")
 
 
@@ -317,4 +340,5 @@ def mesh_model(vertices, faces, *, name: str = "mesh"):
                               length=float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())))
     edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     longest = float(np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1).max())
-    return Model(name=name, panels=tuple(panels), seams=tuple(seams), max_edge=longest)
+    return Model(name=name, panels=tuple(panels), seams=tuple(seams), max_edge=longest,
+                 bookkeeping=Bookkeeping(cuts=len(seams)))

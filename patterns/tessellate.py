@@ -6,6 +6,8 @@ seconds).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse import csgraph
@@ -13,10 +15,11 @@ from scipy.sparse import csgraph
 from .cut import cut_to_disk
 from .errors import CadError, InputError
 from .mesh import drop_unused, face_areas, unique_ints, validate_mesh
-from .model import Model, Panel, Seam, Surface, SurfaceKind
-from .options import check_number
+from .model import Bookkeeping, Model, Panel, Seam, Surface, SurfaceKind
+from .options import Options, option
 
-__all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "mesh_shape", "tessellate_face"]
+__all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "MeshingOptions", "mesh_shape", "parse_panel",
+           "tessellate_face"]
 
 
 def tessellate_face(face, *, tolerance: float = 0.05, angular_tolerance: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
@@ -84,8 +87,54 @@ a tiny ``max_edge`` or ``tolerance`` must not hang the machine."""
 _GRID = 41  # samples per parameter direction of a face's development table
 
 
-def mesh_shape(shape, *, max_edge: float | None = None, tolerance: float = 0.05,
-               angular_tolerance: float = 0.2, faces=None, sew: bool = True, name: str = "shape"):
+def _panel_groups(value, option):
+    """``{name: [CAD face index, ...]}``, checked (indices against the shape later); the CLI gives pairs."""
+    if not hasattr(value, "items"):
+        try:
+            value = dict(value)  # [(name, [indices]), ...] from repeated --panel flags
+        except (TypeError, ValueError):
+            raise InputError(f"{option} must map panel names to lists of CAD face indices, "
+                             f"e.g. {{'front': [0, 1]}}") from None
+    out = {}
+    for label, members in value.items():
+        try:
+            idx = [int(i) for i in members]
+        except (TypeError, ValueError):
+            raise InputError(f"{option}[{label!r}] must be a list of CAD face indices") from None
+        if not idx:
+            raise InputError(f"{option}[{label!r}] is empty")
+        out[str(label)] = idx
+    return out
+
+
+def parse_panel(text: str):
+    """``"NAME=0,1,2"`` (command line) as ``(name, [0, 1, 2])``."""
+    name, sep, members = text.partition("=")
+    if not sep or not name:
+        raise ValueError(f"expected NAME=FACE,FACE,..., got {text!r}")
+    return name, [int(i) for i in members.split(",")]
+
+
+@dataclass(frozen=True, repr=False)
+class MeshingOptions(Options):
+    """How CAD faces are meshed (:func:`mesh_shape`; :func:`patterns.load` of a CAD file or build123d shape)."""
+
+    max_edge: float | None = option(None, "CAD: target triangle edge length, mm (default: about 4000 triangles "
+                                          "over the part, and at least about 1000 on every face)",
+                                    low=0, low_open=True, optional=True, metavar="MM")
+    chord_tolerance: float = option(0.05, "CAD: largest distance from a triangle or segment to the true surface "
+                                          "or edge, mm; curved faces get shorter edges to meet it; also the "
+                                          "sewing tolerance", low=0, low_open=True, metavar="MM")
+    angular_tolerance: float = option(0.2, "CAD: largest angle between the normals at the two ends of a "
+                                           "triangle edge, radians", low=0, low_open=True, metavar="RAD")
+    panels: object = option(None, "CAD: groups of CAD faces (indices in shape.faces() order) cut as one panel "
+                                  "each, e.g. {'front': [0, 1]}; on the command line NAME=0,1 (repeatable)",
+                            check=_panel_groups, parse=parse_panel, repeat=True, flag="--panel", metavar="NAME=FACES")
+    sew: bool = option(True, "CAD: sew faces that meet along an edge without sharing it (a file of loose "
+                             "faces), so that the edge becomes a seam; --no-sew leaves them apart")
+
+
+def mesh_shape(shape, options: MeshingOptions | None = None, *, name: str = "shape", **keywords):
     """Mesh a CAD shape into panels joined by seams, with well-shaped triangles.
 
     Every CAD edge is divided once, at equal arc length, and both faces along
@@ -98,25 +147,22 @@ def mesh_shape(shape, *, max_edge: float | None = None, tolerance: float = 0.05,
     Parameters
     ----------
     shape : OCP ``TopoDS_Shape`` or build123d shape
-    max_edge : float, optional
-        Target edge length, mm (> 0).  Default: the length that gives about
-        :data:`DEFAULT_TRIANGLES` triangles over the shape's area, shorter on
-        a face that would get fewer than :data:`MIN_FACE_TRIANGLES`.
-    tolerance : float
-        Largest distance from a triangle or segment to the true surface or
-        edge, mm (> 0); curved faces and edges get shorter edges to meet it.
-    angular_tolerance : float
-        Largest angle between the normals (tangents) at two ends of a triangle
-        edge (segment), radians (> 0).
-    faces : mapping of str to sequence of int, optional
-        Groups of CAD faces (indices into ``shape.faces()``) to cut as one
-        panel each, e.g. ``{"front": [0, 1]}``; the other faces are panels of
-        their own, named ``"face<i>"``.
-    sew : bool
-        Faces that meet along an edge without sharing it (a STEP or IGES of
-        loose faces) are sewn first (OpenCascade ``BRepBuilderAPI_Sewing``,
-        tolerance ``tolerance``), so that their common edges become seams.
-        Already sewn shapes are left as they are.
+    options : MeshingOptions, optional
+        The options as a record; keywords (any field of
+        :class:`MeshingOptions`) go over it.  ``max_edge``: target edge
+        length, mm (default: the length that gives about
+        :data:`DEFAULT_TRIANGLES` triangles over the shape's area, shorter on a
+        face that would get fewer than :data:`MIN_FACE_TRIANGLES`).
+        ``chord_tolerance``: largest distance from a triangle or segment to the
+        true surface or edge, mm.  ``angular_tolerance``: largest angle
+        between the normals (tangents) at two ends of a triangle edge
+        (segment), radians.  ``panels``: groups of CAD faces (indices into
+        ``shape.faces()``) to cut as one panel each, e.g. ``{"front": [0,
+        1]}``; the other faces are panels of their own, named ``"face<i>"``.
+        ``sew``: faces that meet along an edge without sharing it (a STEP or
+        IGES of loose faces) are sewn first (OpenCascade
+        ``BRepBuilderAPI_Sewing``, at the chord tolerance), so that their
+        common edges become seams; already sewn shapes are left as they are.
     name : str
         For error messages and the model's name.
 
@@ -133,19 +179,16 @@ def mesh_shape(shape, *, max_edge: float | None = None, tolerance: float = 0.05,
     """
     from OCP.TopoDS import TopoDS_Shape
 
+    opts = MeshingOptions.of(options, keywords, name=name)
     wrapped = shape.wrapped if hasattr(shape, "wrapped") else shape
     if not isinstance(wrapped, TopoDS_Shape) or wrapped.IsNull():
         raise InputError(f"{name}: expected a build123d shape or an OCP TopoDS_Shape, got {type(shape).__name__}")
-    tolerance = check_number(tolerance, "tolerance", low=0, low_open=True, name=name)
-    angular_tolerance = check_number(angular_tolerance, "angular_tolerance", low=0, low_open=True, name=name)
-    if max_edge is not None:
-        max_edge = check_number(max_edge, "max_edge (mm)", low=0, low_open=True, name=name)
-    if sew:
-        wrapped = _sewn(wrapped, tolerance)
+    if opts.sew:
+        wrapped = _sewn(wrapped, opts.chord_tolerance)
     mesher = _ShapeMesher(wrapped, name=name)
-    groups = mesher.groups(faces)
-    return mesher.run(groups, max_edge=max_edge, tolerance=float(tolerance),
-                      angular_tolerance=float(angular_tolerance))
+    groups = mesher.groups(opts.panels)
+    return mesher.run(groups, max_edge=opts.max_edge, tolerance=opts.chord_tolerance,
+                      angular_tolerance=opts.angular_tolerance)
 
 
 def _sewn(shape, tolerance: float):
@@ -360,19 +403,10 @@ class _ShapeMesher:
         n = len(self.faces)
         panels, taken = [], {}
         if faces is not None:
-            if not hasattr(faces, "items"):
-                raise InputError(f"{self.name}: faces must map panel names to lists of face indices, "
-                                 f"e.g. {{'front': [0, 1]}}")
-            for label, members in faces.items():
-                try:
-                    idx = [int(i) for i in members]
-                except (TypeError, ValueError):
-                    raise InputError(f"{self.name}: faces[{label!r}] must be a list of face indices") from None
-                if not idx:
-                    raise InputError(f"{self.name}: faces[{label!r}] is empty")
+            for label, idx in faces.items():
                 for i in idx:
                     if not 0 <= i < n:
-                        raise InputError(f"{self.name}: faces[{label!r}] names face {i}; "
+                        raise InputError(f"{self.name}: panels[{label!r}] names CAD face {i}; "
                                          f"the shape has faces 0..{n - 1}")
                     if i in taken:
                         raise InputError(f"{self.name}: face {i} is in two groups, "
@@ -459,7 +493,8 @@ class _ShapeMesher:
             raise CadError(f"{self.name}: faces {sorted(todo)} could not be meshed with their edges kept "
                            f"(a very thin or self-touching face?)")
         panels, seams = self._assemble(groups, meshes)
-        return Model(name=self.name, panels=tuple(panels), seams=tuple(seams), max_edge=h)
+        return Model(name=self.name, panels=tuple(panels), seams=tuple(seams), max_edge=h,
+                     bookkeeping=Bookkeeping(cuts=sum(s.cad_edge is None for s in seams)))
 
     # -- edges ---------------------------------------------------------------
     def _vertex(self, vertex) -> int:

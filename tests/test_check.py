@@ -251,3 +251,28 @@ def test_bad_check_input(cup, tmp_path):
         cup.heat_map(tmp_path / "x.jpg")
     with pytest.raises(InputError, match="placements"):
         cup.placed([(0, 0, 0)])
+
+
+@pytest.mark.parametrize(("stretch", "expected", "opposite"), [(1.02, (103, 0, 31), (5, 48, 97)),
+                                                               (0.98, (5, 48, 97), (103, 0, 31))])
+def test_heat_map_colours_a_known_strain(tmp_path, stretch, expected, opposite):
+    """A panel stretched by 2 % everywhere (flat longer than the surface) is drawn in the scale's
+    red end at a 2 % limit, one squeezed by 2 % in its blue end (RdBu_r: (103, 0, 31) and (5, 48, 97))."""
+    import dataclasses
+
+    from PIL import Image
+
+    exact = patterns.flatten(patterns.load(SAMPLES / "hopper.step"))
+    flat = exact.panels[0]
+    scaled = dataclasses.replace(flat.flattening, uv=flat.flattening.uv * stretch, method="relaxed")
+    pattern = dataclasses.replace(exact, panels=(dataclasses.replace(flat, flattening=scaled),), seams=())
+    assert np.allclose(pattern.panels[0].strains.dominant, stretch - 1.0, atol=1e-3)  # the chords
+    path = tmp_path / "heat.png"
+    pattern.heat_map(path, max_strain=0.02)
+    pixels = np.asarray(Image.open(path).convert("RGB")).reshape(-1, 3).astype(int)
+
+    def share(colour):
+        return np.mean(np.abs(pixels - np.array(colour)).max(axis=1) <= 6)
+
+    assert share(expected) > 0.05  # the panel (and the end of the colour bar)
+    assert share(expected) > 20 * share(opposite)  # the other end only on the colour bar

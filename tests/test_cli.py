@@ -50,7 +50,7 @@ def test_flatten_a_mesh_matches_the_library(tmp_path):
     proc = run("flatten", SAMPLES / "dish.obj", "-o", out)
     assert proc.returncode == 0, proc.stderr
     mesh = read_mesh(SAMPLES / "dish.obj")
-    r = patterns.flatten_mesh(mesh.vertices, mesh.faces, tolerance=1e-6)  # patterns.flatten's default
+    r = patterns.flatten_mesh(mesh.vertices, mesh.faces, energy_tolerance=1e-6)  # patterns.flatten's default
     doc, auditor = recover.readfile(out)
     assert not auditor.has_errors
     (cut,) = doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')

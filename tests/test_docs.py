@@ -104,3 +104,16 @@ def test_code_block_runs(path, line, lang, code, workdirs):
         json.loads(code)
     else:
         pytest.skip(f"a {lang} block")
+
+
+@pytest.mark.parametrize("command", ["flatten", "batch"])
+def test_every_flag_is_in_the_cli_doc(command):
+    """docs/cli.md names every flag the command has (the flags come from the option records)."""
+    from patterns import cli
+
+    parser = cli._parser()
+    sub = next(a for a in parser._actions if a.dest == "command").choices[command]
+    text = (REPO / "docs" / "cli.md").read_text()
+    missing = [s for a in sub._actions for s in a.option_strings if s.startswith("--") and s != "--help"
+               and f"`{s}" not in text]
+    assert not missing, f"docs/cli.md lacks {missing}"

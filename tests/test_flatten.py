@@ -67,7 +67,7 @@ def test_bad_seed_face(bad):
 
 def test_unknown_method():
     v, f = surfaces.paraboloid_dish(n_faces=200)
-    with pytest.raises(InputError, match="unknown flattening method 'lscm'"):
+    with pytest.raises(InputError, match="mesh: method must be one of relaxed, isometric, conformal, got 'lscm'"):
         patterns.flatten_mesh(v, f, method="lscm")
 
 

@@ -80,3 +80,41 @@ def test_missing_file(tmp_path):
 def test_bundled_samples_read(name):
     mesh = read_mesh(SAMPLES / name)
     assert len(mesh.faces) > 500
+
+
+def test_the_model_carries_what_loading_did(tmp_path, capsys):
+    """An STL's welding is on the Model and printed by the CLI (never behind the user's back)."""
+    import patterns
+    from patterns import cli
+
+    v, f = surfaces.paraboloid_dish(n_faces=216)
+    path = tmp_path / "dish.stl"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    corners = 3 * len(f)  # an STL stores every triangle's corners apart
+    model = patterns.load(path)
+    assert model.bookkeeping.welded == corners - len(v)
+    assert model.bookkeeping.unused == 0 and model.bookkeeping.cuts == 0
+    assert cli.main(["info", str(path)]) == 0
+    assert f"{corners - len(v)} vertices welded" in capsys.readouterr().out
+
+
+def test_a_closed_mesh_reports_its_cut(tmp_path):
+    import patterns
+
+    sphere = trimesh.creation.icosphere(subdivisions=2, radius=50.0)
+    path = tmp_path / "ball.obj"
+    sphere.export(path)
+    model = patterns.load(path)
+    assert model.bookkeeping.cuts == 1 == sum(s.cad_edge is None for s in model.seams)
+
+
+@pytest.mark.parametrize(("unit", "mm"), [("mm", 1.0), ("cm", 10.0), ("m", 1000.0), ("in", 25.4)])
+def test_mesh_units_are_converted_to_mm(tmp_path, unit, mm):
+    import patterns
+
+    v, f = surfaces.paraboloid_dish(n_faces=200)
+    path = tmp_path / "dish.obj"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    model = patterns.load(path, units=unit)
+    np.testing.assert_allclose(model.panels[0].vertices, trimesh.load(path, process=False).vertices * mm,
+                               rtol=1e-12)

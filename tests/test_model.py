@@ -122,7 +122,7 @@ def test_build123d_object_to_pattern_in_three_lines():
 
 def test_groups_of_faces_are_one_panel_and_a_closed_group_is_cut_open():
     box = bd.Box(100, 60, 40)
-    model = patterns.load(box, faces={"wrap": [0, 1, 2, 3]})
+    model = patterns.load(box, panels={"wrap": [0, 1, 2, 3]})
     assert [p.name for p in model.panels] == ["wrap", "face4", "face5"]
     assert model.panels[0].cad_faces == (0, 1, 2, 3)
     cuts = [s for s in model.seams if s.cad_edge is None]
@@ -144,15 +144,15 @@ def test_groups_of_faces_are_one_panel_and_a_closed_group_is_cut_open():
         ({"a": [99]}, "faces 0..5"),
         ({"a": []}, "is empty"),
         ([0, 1], "must map panel names"),
-        ({"a": ["x"]}, "list of face indices"),
+        ({"a": ["x"]}, "list of CAD face indices"),
     ],
 )
 def test_bad_groups(faces, words):
     with pytest.raises(InputError, match=words):
-        patterns.load(bd.Box(10, 10, 10), faces=faces)
+        patterns.load(bd.Box(10, 10, 10), panels=faces)
 
 
-@pytest.mark.parametrize("option", [{"max_edge": 0}, {"max_edge": -1.0}, {"tolerance": 0}, {"angular_tolerance": -0.1},
+@pytest.mark.parametrize("option", [{"max_edge": 0}, {"max_edge": -1.0}, {"chord_tolerance": 0}, {"angular_tolerance": -0.1},
                                     {"max_edge": float("nan")}])
 def test_bad_meshing_options(option):
     with pytest.raises(InputError, match=next(iter(option))):
@@ -273,7 +273,7 @@ def test_a_mesh_with_handles_is_refused(tmp_path):
 
 def test_options_that_do_not_apply_are_refused(tmp_path):
     with pytest.raises(InputError, match="CAD files only"):
-        patterns.load(SAMPLES / "dish.obj", faces={"a": [0]})
+        patterns.load(SAMPLES / "dish.obj", panels={"a": [0]})
     with pytest.raises(InputError, match="mesh files only"):
         patterns.load(SAMPLES / "hopper.step", weld_vertices=True)
     with pytest.raises(InputError, match="cannot load a int"):

@@ -50,3 +50,110 @@ def test_dxf_lengths_must_be_finite(tmp_path, option):
     with pytest.raises(InputError, match=option):
         pattern.to_dxf(out, **{option: float("inf")})
     assert not out.exists()
+
+
+# --------------------------------------------------------------------------- #
+# One declaration per option: the API's records and the CLI's flags
+# --------------------------------------------------------------------------- #
+
+import dataclasses  # noqa: E402
+
+from patterns import cli  # noqa: E402
+from patterns.options import cli_flags, from_arguments  # noqa: E402
+
+RECORDS = {"load": patterns.LoadOptions, "flatten": patterns.FlattenOptions, "check": patterns.CheckOptions,
+           "dxf": patterns.DxfOptions}
+COMMANDS = {"flatten": ("load", "flatten", "check", "dxf"), "batch": ("load", "flatten", "check", "dxf"),
+            "check": ("load", "flatten", "check"), "info": ("load",)}
+
+
+def _subparser(command):
+    parser = cli._parser()
+    action = next(a for a in parser._actions if a.dest == "command")
+    return action.choices[command]
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_every_api_option_has_its_cli_flag(command):
+    """Every field of every record the command uses is a flag of that command (flatten and batch alike)."""
+    flags = {s for a in _subparser(command)._actions for s in a.option_strings}
+    for key in COMMANDS[command]:
+        missing = {name: flag for name, flag in cli_flags(RECORDS[key]).items() if flag not in flags}
+        assert not missing, f"patterns {command} lacks flags for {RECORDS[key].__name__}: {missing}"
+
+
+CLI_VALUES = [  # (flag and text, record, the API's keyword and value)
+    (["--max-edge", "2.5"], "load", "max_edge", 2.5),
+    (["--chord-tolerance", "0.02"], "load", "chord_tolerance", 0.02),
+    (["--panel", "front=0,1", "--panel", "back=2"], "load", "panels", {"front": [0, 1], "back": [2]}),
+    (["--no-sew"], "load", "sew", False),
+    (["--weld-vertices", "no"], "load", "weld_vertices", False),
+    (["--units", "in"], "load", "units", "in"),
+    (["--units", "in"], "dxf", "units", "in"),
+    (["--method", "isometric"], "flatten", "method", "isometric"),
+    (["--no-exact"], "flatten", "exact", False),
+    (["--grain", "0,0,2"], "flatten", "grain", (0.0, 0.0, 2.0)),
+    (["--ease", "0:face0:2%"], "flatten", "ease", (patterns.Ease(0, "face0", ratio=0.02),)),
+    (["--dart-strain", "0.03"], "flatten", "max_strain", 0.03),
+    (["--max-darts", "7"], "flatten", "max_darts", 7),
+    (["--energy-tolerance", "1e-7"], "flatten", "energy_tolerance", 1e-7),
+    (["--max-strain", "0.05"], "check", "max_strain", 0.05),
+    (["--max-seam-mismatch", "0.5"], "check", "max_seam_mismatch", 0.5),
+    (["--profile", "astm"], "dxf", "profile", "astm"),
+    (["--dxf-version", "R12"], "dxf", "version", "R12"),
+    (["--strain-layer"], "dxf", "strain_layer", True),
+    (["--text-height", "4"], "dxf", "text_height", 4.0),
+    (["--notch-style", "v"], "dxf", "notch_style", "v"),
+    (["--seam-corners", "square"], "dxf", "seam_corners", "square"),
+]
+
+
+@pytest.mark.parametrize(("argv", "key", "name", "value"), CLI_VALUES)
+def test_a_flag_makes_the_record_the_api_makes(argv, key, name, value):
+    args = cli._parser().parse_args(["flatten", "part.step", "-o", "x.dxf", *argv])
+    from_cli = from_arguments(RECORDS[key], args)
+    assert from_cli == RECORDS[key].of(None, {name: value})
+    assert getattr(from_cli, name) == value
+    # and the flags not given leave the API's defaults
+    defaults = {f.name: f.default for f in dataclasses.fields(RECORDS[key]) if f.name != name}
+    assert all(getattr(from_cli, k) == v for k, v in defaults.items())
+
+
+@pytest.mark.parametrize(("flag", "text", "message"), [
+    ("--max-darts", "-1", "max_darts must be an integer >= 0, got -1"),
+    ("--k-factor", "1.5", "k_factor must be a number between 0 and 1, got 1.5"),
+    ("--text-height", "inf", "text_height must be a positive number, got inf"),
+    ("--max-strain", "0", "max_strain must be a positive number, got 0"),
+    ("--chord-tolerance", "nan", "chord_tolerance must be a positive number, got nan"),
+])
+def test_a_bad_flag_fails_in_one_line_before_loading(tmp_path, capsys, flag, text, message):
+    """The CLI's refusal is the API's message, given before the (missing) input is even read."""
+    code = cli.main(["flatten", str(tmp_path / "missing.step"), "-o", str(tmp_path / "x.dxf"), flag, text])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and message in err[0], err
+    assert not list(tmp_path.iterdir())
+
+
+def test_unknown_keywords_name_the_options():
+    with pytest.raises(InputError, match="unknown option 'max_strian'; the options are max_strain"):
+        patterns.CheckOptions.of(None, {"max_strian": 0.1})
+    pattern = patterns.flatten(patterns.load(SAMPLES / "hopper.step"))
+    with pytest.raises(InputError, match="unknown option 'seam_alowance'"):
+        pattern.to_dxf("never.dxf", seam_alowance=3)
+
+
+def test_records_are_frozen_and_documented():
+    record = patterns.DxfOptions(units="in")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        record.units = "mm"
+    for cls in RECORDS.values():
+        for f in dataclasses.fields(cls):
+            assert f"    {f.name} : " in cls.__doc__, (cls.__name__, f.name)
+
+
+@pytest.mark.parametrize(("unit", "mm", "insunits"), [("mm", 1.0, 4), ("cm", 10.0, 5), ("m", 1000.0, 6),
+                                                       ("in", 25.4, 1)])
+def test_the_unit_table(unit, mm, insunits):
+    """AutoCAD's $INSUNITS codes (1 inch, 4 mm, 5 cm, 6 m) and the size of each unit."""
+    assert patterns.Unit(unit).mm == mm and patterns.Unit(unit).insunits == insunits
+    assert patterns.Unit(unit).measurement == (0 if unit == "in" else 1)

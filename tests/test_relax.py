@@ -116,7 +116,7 @@ def test_pins_that_would_fold_the_pattern_stop_short_and_never_fold():
         ({"pins": 7}, "pins must be"),
         ({"pins": ([0], [[0.0, 0.0]]), "method": "isometric"}, "method='relaxed' only"),
         ({"max_iterations": 0}, "max_iterations"),
-        ({"tolerance": -1.0}, "tolerance"),
+        ({"energy_tolerance": -1.0}, "energy_tolerance"),
     ],
 )
 def test_bad_options(kwargs, words):
@@ -136,11 +136,11 @@ def test_an_exact_start_stops_at_once():
 def test_iterations_and_progress():
     v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=3000)
     calls = []
-    r = patterns.flatten_mesh(v, f, max_iterations=3, tolerance=0.0,
+    r = patterns.flatten_mesh(v, f, max_iterations=3, energy_tolerance=0.0,
                               progress=lambda done, total: calls.append((done, total)))
     assert r.iterations == 3 and calls == [(1, 3), (2, 3), (3, 3)]
     assert not r.converged
-    longer = patterns.flatten_mesh(v, f, max_iterations=200, tolerance=1e-6)
+    longer = patterns.flatten_mesh(v, f, max_iterations=200, energy_tolerance=1e-6)
     assert longer.distortion.strain_rms <= r.distortion.strain_rms
 
 

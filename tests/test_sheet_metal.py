@@ -70,7 +70,7 @@ def annular_sector(s_in, s_out, t0, t1, step=0.01):
 @pytest.fixture(scope="module")
 def hopper():
     # Chords within 0.02 mm of the surface: the developed arcs then sag < 0.01 mm.
-    return patterns.flatten(patterns.load(SAMPLES / "hopper.step", tolerance=0.02)).placed([(0.0, 0.0, 0.0)])
+    return patterns.flatten(patterns.load(SAMPLES / "hopper.step", chord_tolerance=0.02)).placed([(0.0, 0.0, 0.0)])
 
 
 @pytest.mark.parametrize("arcs", [False, True])

@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import re
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,15 +20,13 @@ from shapely.geometry.polygon import orient
 from ..errors import InputError
 from ..files import atomic_output
 from ..measure import strain_stats, triangle_strains
-from ..options import check_number, is_number
+from ..options import Options, check_number, is_number, option
+from ..units import UNIT_NAMES, Unit
 from .arcs import fit_arcs
 from .heatmap import display_offsets
 
-__all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "PROFILES", "UNITS", "seam_label",
+__all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "PROFILES", "DxfOptions", "seam_label",
            "write_outline_dxf", "write_pattern_dxf"]
-
-UNITS = {"mm": 4, "cm": 5, "m": 6, "in": 1}
-"""Unit names accepted by the writers and their DXF ``$INSUNITS`` codes."""
 
 
 def write_outline_dxf(path, loops: Sequence[np.ndarray], *, units: str = "mm", layer: str = "CUT") -> None:
@@ -53,15 +52,15 @@ def write_outline_dxf(path, loops: Sequence[np.ndarray], *, units: str = "mm", l
     """
     import ezdxf  # heavy; only when exporting
 
-    if units not in UNITS:
-        raise InputError(f"unknown unit {units!r}; choose one of {', '.join(UNITS)}")
+    if units not in UNIT_NAMES:
+        raise InputError(f"{path}: unknown unit {units!r}; choose one of {', '.join(UNIT_NAMES)}")
     for i, loop in enumerate(loops):
         loop = np.asarray(loop)
         if loop.ndim != 2 or loop.shape[1] != 2 or len(loop) < 3 or not np.all(np.isfinite(loop)):
             raise InputError(f"{path}: loop {i} is not a finite (k >= 3, 2) array")
     doc = ezdxf.new("R2000", setup=False)
-    doc.header["$INSUNITS"] = UNITS[units]
-    doc.header["$MEASUREMENT"] = 0 if units == "in" else 1
+    doc.header["$INSUNITS"] = Unit(units).insunits
+    doc.header["$MEASUREMENT"] = Unit(units).measurement
     doc.layers.add(layer, color=1)
     msp = doc.modelspace()
     for loop in loops:
@@ -80,6 +79,68 @@ PROFILES = ("machine", "astm")
 NOTCH_STYLES = ("slit", "v")
 """Notch shapes: a slit across the seam allowance, or a V."""
 
+SEAM_CORNERS = ("mitre", "square")
+"""Corners of the seam allowance."""
+
+MACHINE_VERSIONS = {"R12": "AC1009", "R2000": "AC1015", "R2004": "AC1018", "R2007": "AC1021",
+                    "R2010": "AC1024", "R2013": "AC1027", "R2018": "AC1032"}
+"""DXF versions the machine profile writes, and their ``$ACADVER``."""
+
+
+def _seam_allowance(value, option):
+    """A number (mm, >= 0) or a mapping ``{seam id or None: mm}``, checked (seam ids against the pattern later)."""
+    if hasattr(value, "items"):
+        return dict((key, check_number(mm, f"{option}[{key!r}] (mm)", low=0)) for key, mm in value.items())
+    if is_number(value):
+        return check_number(value, f"{option} (mm)", low=0)
+    raise InputError(f"{option} must be a number (mm) or a mapping of seam ids to mm, got {type(value).__name__}")
+
+
+@dataclass(frozen=True, repr=False)
+class DxfOptions(Options):
+    """How a pattern is written as DXF (:meth:`patterns.Pattern.to_dxf`, ``patterns flatten -o X.dxf``)."""
+
+    profile: str = option("machine", "DXF dialect: machine (laser, plasma, waterjet, knife plotter: layers CUT, "
+                                     "SEW, NOTCH, GRAIN, BEND, LABEL) or astm (garment CAD: ASTM D6673, R12, one "
+                                     "block per piece); see docs/dxf.md", choices=PROFILES)
+    seam_allowance: object = option(0.0, "seam allowance added outside the seam line, mm: one number for every "
+                                         "edge, or (API) a mapping {seam id: mm, None: mm for every other edge}; "
+                                         "the seam line then goes on SEW (ASTM layer 14)",
+                                    check=_seam_allowance, parse=float, metavar="MM")
+    units: str = option("mm", "unit of the drawing (machine profile; ASTM is mm); also, on the command line, "
+                              "the unit of a mesh file's coordinates", choices=UNIT_NAMES)
+    version: str | None = option(None, "machine profile: DXF version (default R2000; ASTM is R12)",
+                                 choices=tuple(MACHINE_VERSIONS), flag="--dxf-version", optional=True)
+    strain_layer: bool = option(False, "machine profile: the strain heat map as filled triangles on layer STRAIN "
+                                       "(true colour from R2004)")
+    text_height: float | None = option(None, "label height, mm (default 3 % of each panel's size, 2-12 mm)",
+                                       low=0, low_open=True, optional=True, metavar="MM")
+    gap: float | None = option(None, "space between panels when the pattern is not laid out, mm",
+                               low=0, optional=True, metavar="MM")
+    arcs: bool = option(False, "machine profile: cut contours as arcs and lines fitted within arc_tolerance")
+    arc_tolerance: float = option(0.01, "largest distance of the fitted arcs from the contour, mm",
+                                  low=0, low_open=True, metavar="MM")
+    bend_spacing: float | None = option(None, "draw the rulings of exactly developed cylinders and cones about "
+                                              "this far apart (mm) on BEND with their bend angles",
+                                        low=0, low_open=True, optional=True, metavar="MM")
+    notch_spacing: float | None = option(None, "matching notches along every seam every this many mm of 3D "
+                                               "length, on both panels (default: at the seam ends only)",
+                                         low=0, low_open=True, optional=True, metavar="MM")
+    notch_style: str = option("slit", "notch shape: a slit across the seam allowance, or a V", choices=NOTCH_STYLES)
+    seam_corners: str = option("mitre", "corners of the seam allowance: offset lines meeting at a point (mitre), "
+                                        "or each side's allowance run straight on past the corner (square)",
+                               choices=SEAM_CORNERS)
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.profile == "astm":
+            if self.version not in (None, "R12"):
+                raise InputError(f"the ASTM profile is written as R12 only, not {self.version!r}")
+            if self.units != "mm":
+                raise InputError("the ASTM profile is written in mm (METRIC) only")
+            if self.arcs:
+                raise InputError("arcs are written in the machine profile only")
+
 MACHINE_LAYERS = {
     "CUT": 1,  # red: every cut contour, one closed polyline each
     "SEW": 5,  # blue: the seam line, when a seam allowance is added
@@ -94,10 +155,6 @@ MACHINE_LAYERS = {
 ASTM_LAYERS = {1: "cut line, piece text", 2: "turn points", 3: "curve points", 4: "notches", 7: "grain line",
                8: "internal lines", 11: "internal cut-outs", 14: "sew line", 15: "annotation"}
 """Layers of the ASTM D6673 profile."""
-
-MACHINE_VERSIONS = {"R12": "AC1009", "R2000": "AC1015", "R2004": "AC1018", "R2007": "AC1021",
-                    "R2010": "AC1024", "R2013": "AC1027", "R2018": "AC1032"}
-"""DXF versions the machine profile can write (R2000 by default)."""
 
 
 class _PanelGeometry:
@@ -239,21 +296,15 @@ def _snap(loop: np.ndarray, tol: float = 1e-6) -> np.ndarray:
 
 
 def _allowance_lookup(seam_allowance, seam_ids, path):
-    """A function ``seam id or None -> allowance, mm`` from a number or a mapping."""
-    if is_number(seam_allowance):
-        value = check_number(seam_allowance, "seam_allowance (mm)", low=0, name=str(path))
-        return lambda seam: value
-    if hasattr(seam_allowance, "items"):
-        table = {}
-        for key, value in seam_allowance.items():
-            if key is not None and key not in seam_ids:
-                raise InputError(f"{path}: seam_allowance names seam {key!r}, which the pattern does not have "
-                                 f"(seams {sorted(seam_ids)}; None for every other edge)")
-            table[key] = check_number(value, f"seam_allowance[{key!r}] (mm)", low=0, name=str(path))
-        default = table.get(None, 0.0)
-        return lambda seam: table.get(seam, default)
-    raise InputError(f"{path}: seam_allowance must be a number (mm) or a mapping of seam ids to mm, "
-                     f"got {type(seam_allowance).__name__}")
+    """A function ``seam id or None -> allowance, mm`` from a checked number or mapping (:class:`DxfOptions`)."""
+    if not isinstance(seam_allowance, dict):
+        return lambda seam: seam_allowance
+    for key in seam_allowance:
+        if key is not None and key not in seam_ids:
+            raise InputError(f"{path}: seam_allowance names seam {key!r}, which the pattern does not have "
+                             f"(seams {sorted(seam_ids)}; None for every other edge)")
+    default = seam_allowance.get(None, 0.0)
+    return lambda seam: seam_allowance.get(seam, default)
 
 
 def _readable_angle(direction) -> float:
@@ -351,57 +402,33 @@ def _notches(pattern, geo, allowance_of, spacing=None):
     return out
 
 
-def write_pattern_dxf(pattern, path, *, profile: str = "machine", seam_allowance=0.0, units: str = "mm",
-                      version: str | None = None, strain_layer: bool = False, text_height: float | None = None,
-                      gap: float | None = None, arcs: bool = False, arc_tolerance: float = 0.01,
-                      bend_spacing: float | None = None, notch_spacing: float | None = None,
-                      notch_style: str = "slit", seam_corners: str = "mitre") -> None:
-    """Write a whole pattern as a DXF for cutters.
+def write_pattern_dxf(pattern, path, options: DxfOptions | None = None, **keywords) -> None:
+    """Write a whole pattern as a DXF for cutters (atomically: a refused or failed write leaves nothing).
 
-    See :meth:`patterns.Pattern.to_dxf` and docs/dxf.md for the two profiles.
+    Parameters
+    ----------
+    pattern : patterns.Pattern
+    path : str or Path
+    options : DxfOptions, optional
+        The options, as a record; ``keywords`` (any :class:`DxfOptions` field)
+        go over it.  See :meth:`patterns.Pattern.to_dxf` and docs/dxf.md.
     """
     import ezdxf
 
-
-    if profile not in PROFILES:
-        raise InputError(f"{path}: unknown DXF profile {profile!r}; choose one of {', '.join(PROFILES)}")
-    if units not in UNITS:
-        raise InputError(f"{path}: unknown unit {units!r}; choose one of {', '.join(UNITS)}")
-    if profile == "astm":
-        if version not in (None, "R12"):
-            raise InputError(f"{path}: the ASTM profile is written as R12 only, not {version!r}")
-        if units != "mm":
-            raise InputError(f"{path}: the ASTM profile is written in mm (METRIC) only")
-        version = "R12"
-    version = version or "R2000"
-    if version not in MACHINE_VERSIONS:
-        raise InputError(f"{path}: unknown DXF version {version!r}; choose one of {', '.join(MACHINE_VERSIONS)}")
-    check_number(arc_tolerance, "arc_tolerance (mm)", low=0, low_open=True, name=str(path))
-    for option, value in (("text_height", text_height), ("bend_spacing", bend_spacing),
-                          ("notch_spacing", notch_spacing)):
-        if value is not None:
-            check_number(value, f"{option} (mm)", low=0, low_open=True, name=str(path))
-    if seam_corners not in ("mitre", "square"):
-        raise InputError(f"{path}: seam_corners must be 'mitre' or 'square', got {seam_corners!r}")
-    if notch_style not in NOTCH_STYLES:
-        raise InputError(f"{path}: notch_style must be one of {', '.join(NOTCH_STYLES)}, got {notch_style!r}")
-    if arcs and profile != "machine":
-        raise InputError(f"{path}: arcs are written in the machine profile only")
-    allowance_of = _allowance_lookup(seam_allowance, {s.seam.id for s in pattern.seams}, path)
-    scale = {"mm": 1.0, "cm": 0.1, "m": 0.001, "in": 1 / 25.4}[units]
+    opts = DxfOptions.of(options, keywords, name=str(path))
+    allowance_of = _allowance_lookup(opts.seam_allowance, {s.seam.id for s in pattern.seams}, path)
     biggest = max(float(np.max(_allowance_values(pattern, allowance_of))), 0.0)
-    offsets = display_offsets(pattern, gap=gap if gap is not None else None, margin=biggest)
-    geos = [_PanelGeometry(pattern, i, offsets[i], allowance_of, text_height, seam_corners)
+    offsets = display_offsets(pattern, gap=opts.gap, margin=biggest)
+    geos = [_PanelGeometry(pattern, i, offsets[i], allowance_of, opts.text_height, opts.seam_corners)
             for i in range(len(pattern.panels))]
-    if profile == "machine":
-        doc = _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer,
-                           arc_tolerance if arcs else None, bend_spacing, offsets, notch_spacing, notch_style)
+    if opts.profile == "machine":
+        doc = _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts)
         with atomic_output(path, what="DXF file") as tmp:
             _save(doc, tmp)
     else:
         from ezdxf.addons import gerber_D6673
 
-        doc = _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets, notch_spacing, notch_style)
+        doc = _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts)
         with atomic_output(path, what="DXF file") as tmp:
             gerber_D6673.export_file(doc, tmp)
 
@@ -410,13 +437,18 @@ def _allowance_values(pattern, allowance_of):
     return [allowance_of(None)] + [allowance_of(s.seam.id) for s in pattern.seams]
 
 
-def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, strain_layer, arc_tolerance,
-                 bend_spacing, offsets, notch_spacing=None, notch_style="slit"):
+def _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
+    version = opts.version or "R2000"
+    unit = Unit(opts.units)
+    scale = 1.0 / unit.mm  # drawing units per mm
+    arc_tolerance = opts.arc_tolerance if opts.arcs else None
+    bend_spacing, notch_spacing, notch_style, strain_layer = (opts.bend_spacing, opts.notch_spacing,
+                                                              opts.notch_style, opts.strain_layer)
     r12 = version == "R12"
-    doc = _new_doc(ezdxf, version, 0 if r12 else UNITS[units])
+    doc = _new_doc(ezdxf, version, 0 if r12 else unit.insunits)
     if not r12:
-        doc.header["$INSUNITS"] = UNITS[units]
-    doc.header["$MEASUREMENT"] = 0 if units == "in" else 1
+        doc.header["$INSUNITS"] = unit.insunits
+    doc.header["$MEASUREMENT"] = unit.measurement
     for name, color in MACHINE_LAYERS.items():
         if name != "STRAIN" or strain_layer:
             doc.layers.add(name, color=color)
@@ -479,7 +511,7 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, version, units, scale, stra
         if strain_layer:
             _strain_solids(msp, pattern.panels[g.index], g.uv, scale, truecolor=version not in ("R12", "R2000"))
     if r12:
-        text(f"UNITS: {units.upper()}", [geos[0].box[0], geos[0].box[1] - 3 * geos[0].text_height],
+        text(f"UNITS: {unit.label}", [geos[0].box[0], geos[0].box[1] - 3 * geos[0].text_height],
              geos[0].text_height)
     return doc
 
@@ -555,8 +587,9 @@ def _strain_solids(msp, flat, uv, scale, truecolor):
         msp.add_solid([tuple(p[0]), tuple(p[1]), tuple(p[2])], dxfattribs=attribs)
 
 
-def _astm_doc(ezdxf, pattern, geos, allowance_of, bend_spacing, offsets, notch_spacing=None, notch_style="slit"):
+def _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
     """ASTM D6673 (AAMA) R12 document: one block per piece, inserted on layer 1."""
+    bend_spacing, notch_spacing, notch_style = opts.bend_spacing, opts.notch_spacing, opts.notch_style
     doc = _new_doc(ezdxf, "R12", 0)
     for layer in ASTM_LAYERS:
         doc.layers.add(str(layer))

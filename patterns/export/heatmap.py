@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..files import atomic_output
+from ..options import check_number
 
 __all__ = ["HEAT_MAP_FORMATS", "display_offsets", "heat_map"]
 
@@ -80,9 +81,8 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
     suffix = path.suffix.lower()
     if suffix not in HEAT_MAP_FORMATS:
         raise InputError(f"{path}: heat maps are written as {' or '.join(HEAT_MAP_FORMATS)}, not {suffix or '(none)'!r}")
-    if max_strain is not None and not (isinstance(max_strain, (int, float)) and np.isfinite(max_strain)
-                                       and max_strain > 0):
-        raise InputError(f"{path}: max_strain must be a positive number, got {max_strain!r}")
+    if max_strain is not None:
+        max_strain = check_number(max_strain, "max_strain", low=0, low_open=True, name=str(path))
     offsets = display_offsets(pattern)
     strains = [p.strains for p in pattern.panels]
     worst = max(float(np.max(np.abs(s.dominant))) for s in strains)

@@ -12,7 +12,8 @@
   (:mod:`~patterns.flattening.darts`) and grain (:mod:`~patterns.flattening.grain`).
 """
 
-from .engine import METHODS, Flattening, flatten_mesh
+from .engine import Flattening, flatten_mesh
 from .panels import flatten
+from .settings import METHODS, FlattenOptions
 
-__all__ = ["METHODS", "Flattening", "flatten", "flatten_mesh"]
+__all__ = ["METHODS", "FlattenOptions", "Flattening", "flatten", "flatten_mesh"]

@@ -30,12 +30,9 @@ from ..model import SurfaceKind
 from ..options import check_number
 from ..predicates import overlap_verdict
 from .engine import Flattening
+from .settings import REFERENCES
 
 __all__ = ["REFERENCES", "develop", "developed", "neutral_offset", "offset_along_normals", "offset_points"]
-
-REFERENCES = ("inside", "outside", "mid")
-"""Which skin of the sheet the CAD model shows."""
-
 
 def neutral_offset(thickness: float, k_factor: float, reference: str, *, name: str = "pattern") -> float:
     """Signed distance from the modelled skin to the neutral surface, mm (positive: convex side).

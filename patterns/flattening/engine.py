@@ -17,19 +17,15 @@ from threadpoolctl import threadpool_limits
 from ..errors import FlattenError, InputError, PatternsError
 from ..measure import Distortion, distortion, local_coordinates, signed_areas
 from ..mesh import _readonly, as_mesh_arrays, validate_mesh
-from ..options import check_number, is_number
+from ..options import is_number
 from ..predicates import Overlap, overlap_verdict
 from . import grow
 from .embed import lscm, tutte_embedding
-from .energy import ENERGIES
 from .numbering import dissection_order, renumber, renumber_connectivity, spatial_order
 from .relax import align_to_pins, best_scale, check_lengths, check_pins, is_isometric, relax
+from .settings import METHODS, FlattenOptions
 
 __all__ = ["METHODS", "Flattening", "flatten_mesh"]
-
-METHODS = ("relaxed", "isometric", "conformal")
-"""The flattening methods :func:`flatten_mesh` accepts."""
-
 
 @dataclass(frozen=True, eq=False)
 class Flattening:
@@ -99,7 +95,7 @@ class Flattening:
 
 
 def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | None = None,
-                 pins=None, max_iterations: int = 500, tolerance: float = 1e-5,
+                 pins=None, max_iterations: int = 500, energy_tolerance: float = 1e-5,
                  min_stretch: float | None = None, energy: str = "auto", lengths=None, progress=None,
                  name: str = "mesh") -> Flattening:
     """Flatten a triangle mesh to the plane at true scale.
@@ -144,7 +140,7 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         ``"relaxed"`` only: at most this many relaxation iterations (> 0).
         Mildly curved parts converge in 6-15, heads and other strongly
         curved parts that start from LSCM in 50-250.
-    tolerance : float
+    energy_tolerance : float
         ``"relaxed"`` only: stop when the energy falls by less than this
         fraction per iteration (averaged over two; >= 0).
     min_stretch : float in (0, 1), optional
@@ -188,22 +184,19 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         The conformal grower's scale error grew beyond double precision (the
         flat triangle areas overflow).
     """
-    if method not in METHODS:
-        raise InputError(f"unknown flattening method {method!r}; choose one of {', '.join(METHODS)}")
-    # Cheap option checks before the mesh is validated (a second at 1M faces).
-    if method != "relaxed" and pins is not None:
-        raise InputError(f"{name}: pins apply to method='relaxed' only")
-    if min_stretch is not None:
-        if method != "relaxed":
-            raise InputError(f"{name}: min_stretch applies to method='relaxed' only")
-        min_stretch = check_number(min_stretch, "min_stretch", low=0, high=1, low_open=True, high_open=True,
-                                   name=name)
-    max_iterations = check_number(max_iterations, "max_iterations", low=0, low_open=True, integer=True, name=name)
-    tolerance = check_number(tolerance, "tolerance", low=0, name=name)
-    if energy not in ENERGIES:
-        raise InputError(f"{name}: unknown energy {energy!r}; choose one of {', '.join(ENERGIES)}")
-    if method != "relaxed" and (lengths is not None or energy != "auto"):
-        raise InputError(f"{name}: {'lengths' if lengths is not None else 'energy'} applies to method='relaxed' only")
+    # Cheap option checks, by the declarations patterns.flatten uses, before the
+    # mesh is validated (a second at 1M faces).
+    method = FlattenOptions.checked("method", method, where=name)
+    if method != "relaxed":
+        for option, value in (("pins", pins), ("min_stretch", min_stretch), ("lengths", lengths)):
+            if value is not None:
+                raise InputError(f"{name}: {option} applies to method='relaxed' only")
+        if energy != "auto":
+            raise InputError(f"{name}: energy applies to method='relaxed' only")
+    min_stretch = FlattenOptions.checked("min_stretch", min_stretch, where=name)
+    max_iterations = FlattenOptions.checked("max_iterations", max_iterations, where=name)
+    energy_tolerance = FlattenOptions.checked("energy_tolerance", energy_tolerance, where=name)
+    energy = FlattenOptions.checked("energy", energy, where=name)
     v, f, num, conn = _working_mesh(vertices, faces, name)
     if seed_face is not None and not (is_number(seed_face, integer=True) and 0 <= seed_face < len(f)):
         raise InputError(f"{name}: seed_face must be a face index in [0, {len(f)}), got {seed_face!r}")
@@ -221,7 +214,7 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         # One BLAS thread: a sum split between threads rounds differently, and the
         # pattern must not depend on the machine's thread count.
         uv, extras = _engine(wv, wf, conn, seed, method, pins, lengths, progress, name, max_iterations=max_iterations,
-                             tolerance=tolerance, min_stretch=min_stretch, energy=energy)
+                             tolerance=energy_tolerance, min_stretch=min_stretch, energy=energy)
     loops = conn.loops
     if num is not None:  # back to the input's numbering
         uv, seed = np.ascontiguousarray(uv[num.vertex_inverse]), int(num.face[seed])

@@ -14,76 +14,54 @@ import numpy as np
 from ..errors import InputError
 from ..mesh import unique_edges
 from ..model import Model
-from ..options import check_number
 from ..pattern import FlatPanel, FlatSeam, Pattern
 from .darts import cut_darts
 from .develop import developed, neutral_offset, offset_along_normals
-from .engine import METHODS, Flattening, flatten_mesh
+from .engine import Flattening, flatten_mesh
 from .grain import grain_table, turn_to_grain
-from .seams import SeamLengths, held_lengths, seam_edges, seam_mode, validate_ease
+from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
+from .settings import FlattenOptions
 
 __all__ = ["flatten"]
 
 
-def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: float = 0.0, k_factor: float = 0.5,
-            reference: str = "mid", grain=None, seams: str = "true", ease=None, max_strain: float | None = None,
-            max_darts: int = 60, max_iterations: int = 500, tolerance: float = 1e-6, min_stretch: float | None = None,
-            energy: str = "auto", progress=None):
+def flatten(model, options: FlattenOptions | None = None, *, progress=None, **keywords) -> Pattern:
     """Lay every panel of a model flat at true scale.
 
     Parameters
     ----------
     model : patterns.Model
         From :func:`patterns.load`.
-    method : {"relaxed", "isometric", "conformal"}
-        The mesh engine, for freeform panels (see :func:`flatten_mesh`).
-    exact : bool
-        Unroll planar, cylindrical and conical CAD faces analytically
-        (:mod:`patterns.flattening.develop`: exact to round-off, no mesh engine);
-        their :attr:`Flattening.method` is ``"exact"``.  False sends them
-        through the engine too.
-    thickness : float
-        Sheet thickness, mm (>= 0).  With a thickness the pattern is the
-        development of the neutral surface, ``k_factor * thickness`` from the
-        inside skin, so that the blank forms to the modelled size.
-    k_factor : float
-        Position of the neutral surface in the sheet, from the inside (0..1).
-    reference : {"inside", "outside", "mid"}
-        Which skin the model shows.  The offset goes towards the convex side of
-        cylinders and cones (away from their axis), along the face normal on
-        freeform faces.
-    grain : (3,) float or mapping of panel name to (3,), optional
-        A 3D direction (the fabric's grain, a sheet's rolling direction): each
-        flat panel is turned so that this direction, as it lies on the panel,
-        points along +Y.  One direction for all panels, or one per panel name
-        (panels not named keep their orientation).  Only rotations: nothing
-        is scaled.
-    seams : {"true", "total", "free"}
-        ``"true"`` (default): every seam edge of a freeform panel is held flat
-        at its 3D length (``method="relaxed"``; :mod:`patterns.flattening.seams`),
-        so that each seam is as long flat as in 3D and its two sides match
-        point by point, also against an exactly developed neighbour.
-        ``"total"``: only each seam side's total length is held (less strain;
-        points along the seam may drift a few mm from their mate's).
-        ``"free"``: the boundary takes the least-strain lengths (seams come
-        out longer or shorter, and the two sides of a seam differ).
-    ease : Ease or sequence of Ease, optional
-        Deliberate extra (or less) length on one side of a seam
-        (:class:`~patterns.flattening.seams.Ease`): that side is held at its 3D
-        length times ``1 + ratio``, plus ``mm``.  An eased side of a planar,
-        cylindrical or conical panel sends that panel through the engine.
-    max_strain : float, optional
-        Largest acceptable triangle strain (0.03 = 3 %).  A freeform panel that
-        comes out above it is cut, one dart at a time, from the outline to its
-        most strained point by the shortest path along its edges (the paper's
-        "segmentation"), and flattened again, until it is within the limit or
-        ``max_darts`` cuts are made (``patterns.check`` then reports it).
-        Every cut is in :attr:`FlatPanel.darts`.
-    max_darts : int
-        At most this many darts per panel.
-    max_iterations, tolerance, min_stretch, energy
-        ``"relaxed"`` only; see :func:`flatten_mesh`.  The tolerance here is
-        1e-6 (``flatten_mesh``: 1e-5): a pattern is relaxed to convergence.
+    options : FlattenOptions, optional
+        The options as a record; keywords (any field of
+        :class:`~patterns.FlattenOptions`) go over it:
+
+        * ``method`` (``"relaxed"``): the mesh engine for freeform panels (see
+          :func:`flatten_mesh`); ``exact`` (True): planar, cylindrical and
+          conical CAD faces are unrolled analytically
+          (:mod:`patterns.flattening.develop`: exact to round-off), their
+          :attr:`Flattening.method` is ``"exact"``;
+        * ``thickness`` (mm), ``k_factor``, ``reference`` (``"inside"``,
+          ``"outside"``, ``"mid"``): a sheet's neutral surface is developed, at
+          ``k_factor * thickness`` from the inside skin, offset towards the
+          convex side of cylinders and cones, along the face normal on
+          freeform faces;
+        * ``grain``: a 3D direction (or ``{panel name: direction}``) turned to
+          +Y on each flat panel (a rotation only);
+        * ``seams`` (``"true"``): every seam edge of a freeform panel held flat
+          at its 3D length (:mod:`patterns.flattening.seams`), so that each
+          seam is as long flat as in 3D and its two sides match point by point;
+          ``"total"``: each side's total length only; ``"free"``: the
+          least-strain lengths;
+        * ``ease``: :class:`~patterns.Ease` entries, deliberate extra (or less)
+          length on one side of a seam;
+        * ``max_strain``, ``max_darts`` (60): a freeform panel above the strain
+          is cut, one dart at a time, from the outline to its most strained
+          point (:mod:`patterns.flattening.darts`), until within the limit or
+          ``max_darts`` cuts; every cut is in :attr:`FlatPanel.darts`;
+        * ``max_iterations`` (500), ``energy_tolerance`` (1e-6; ``flatten_mesh``:
+          1e-5, a pattern is relaxed to convergence), ``min_stretch``,
+          ``energy`` (``"auto"``): the relaxation, see :func:`flatten_mesh`.
     progress : callable, optional
         ``progress(panels_done, n_panels)`` after each panel.
 
@@ -103,31 +81,27 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
     """
     if not isinstance(model, Model):
         raise InputError(f"flatten() takes a patterns.Model (from patterns.load), got {type(model).__name__}")
-    if method not in METHODS:
-        raise InputError(f"unknown flattening method {method!r}; choose one of {', '.join(METHODS)}")
-    offset = neutral_offset(thickness, k_factor, reference, name=model.name)
-    grains = grain_table(grain, model)
-    mode = seam_mode(seams)
-    eased = validate_ease(ease, model)
-    if eased and (mode is SeamLengths.FREE or method != "relaxed"):
-        raise InputError(f"{model.name}: ease needs seams='true' or 'total' and method='relaxed'")
-    if max_strain is not None:
-        max_strain = check_number(max_strain, "max_strain", low=0, low_open=True, name=model.name)
-    max_darts = check_number(max_darts, "max_darts", low=0, integer=True, name=model.name)
+    opts = FlattenOptions.of(options, keywords, name=model.name)
+    method, max_strain, max_darts = opts.method, opts.max_strain, opts.max_darts
+    offset = neutral_offset(opts.thickness, opts.k_factor, opts.reference, name=model.name)
+    grains = grain_table(opts.grain, model)
+    mode = SeamLengths(opts.seams)
+    eased = validate_ease(opts.ease, model)
     eased_panels = {model.seams[s].panels[side] for s, side in eased}
     flat, targets = [], {}
     for i, panel in enumerate(model.panels):
         name = f"{model.name}: panel {panel.name}"
         darts = ()
-        if exact and panel.surface is not None and i not in eased_panels:
+        if opts.exact and panel.surface is not None and i not in eased_panels:
             result = developed(panel, offset, name)
         else:
             vertices = offset_along_normals(panel, offset) if offset else panel.vertices
             held = None
             if method == "relaxed":
                 held = held_lengths(model, i, vertices, eased, mode, mesh_edges=unique_edges(panel.faces))
-            options = dict(method=method, max_iterations=max_iterations, tolerance=tolerance,
-                           min_stretch=min_stretch, energy=energy, name=name)
+            options = dict(method=method, max_iterations=opts.max_iterations,
+                           energy_tolerance=opts.energy_tolerance, min_stretch=opts.min_stretch, energy=opts.energy,
+                           name=name)
             result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
             if max_strain is not None:
                 result, darts = cut_darts(result, max_strain, max_darts, held, options)
@@ -144,7 +118,7 @@ def flatten(model, *, method: str = "relaxed", exact: bool = True, thickness: fl
         held_at = tuple(targets.get((seam.id, side)) for side in range(2))
         seams_out.append(FlatSeam(seam, lengths, None if None in held_at else held_at))
     return Pattern(model=model, panels=tuple(flat), seams=tuple(seams_out), method=method,
-                   thickness=float(thickness), k_factor=float(k_factor), reference=reference)
+                   thickness=opts.thickness, k_factor=opts.k_factor, reference=opts.reference)
 
 
 def _flat_length(result: Flattening, edges: np.ndarray, idx) -> float:

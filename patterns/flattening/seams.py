@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import InputError
 from ..options import check_number, is_number
 
-__all__ = ["Ease", "SeamLengths", "held_lengths", "seam_edges", "seam_mode", "validate_ease"]
+__all__ = ["Ease", "SeamLengths", "held_lengths", "seam_edges", "validate_ease"]
 
 
 class SeamLengths(str, Enum):
@@ -64,15 +64,6 @@ class Ease:
     panel: str
     mm: float = 0.0
     ratio: float = 0.0
-
-
-def seam_mode(value) -> SeamLengths:
-    """``seams=`` as a :class:`SeamLengths`; InputError naming the choices otherwise."""
-    try:
-        return SeamLengths(value)
-    except ValueError:
-        choices = ", ".join(repr(m.value) for m in SeamLengths)
-        raise InputError(f"unknown seams option {value!r}; choose one of {choices}") from None
 
 
 def validate_ease(ease, model) -> dict:

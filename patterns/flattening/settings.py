@@ -1,0 +1,124 @@
+"""The options of :func:`patterns.flatten`, declared once: :class:`FlattenOptions`.
+
+The command line makes its flattening flags from these fields; the mesh engine
+(:func:`patterns.flatten_mesh`) checks its own relaxation keywords with the same
+declarations (:meth:`FlattenOptions.checked`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..options import Options, option
+from .energy import ENERGIES
+from .seams import Ease, SeamLengths
+
+__all__ = ["METHODS", "REFERENCES", "FlattenOptions", "parse_direction", "parse_ease"]
+
+METHODS = ("relaxed", "isometric", "conformal")
+"""The flattening methods :func:`patterns.flatten_mesh` accepts."""
+
+REFERENCES = ("inside", "outside", "mid")
+"""Which skin of the sheet the CAD model shows."""
+
+
+def parse_direction(text: str):
+    """``"X,Y,Z"`` (command line) as a tuple of three floats."""
+    try:
+        values = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise ValueError(f"expected X,Y,Z numbers, got {text!r}") from None
+    if len(values) != 3:
+        raise ValueError(f"expected three numbers X,Y,Z, got {text!r}")
+    return values
+
+
+def parse_ease(text: str) -> Ease:
+    """``"SEAM:PANEL:AMOUNT"`` (command line; mm, or a percentage with ``%``) as an :class:`Ease`."""
+    try:
+        seam, panel, amount = text.split(":")
+        if amount.endswith("%"):
+            return Ease(int(seam), panel, ratio=float(amount[:-1]) / 100.0)
+        return Ease(int(seam), panel, mm=float(amount))
+    except ValueError:
+        raise ValueError(f"expected SEAM:PANEL:MM or SEAM:PANEL:PERCENT%, got {text!r}") from None
+
+
+def _grain(value, option):
+    """A 3D direction, or a mapping of panel names to 3D directions (names checked against the model later)."""
+    if hasattr(value, "items"):
+        return {str(name): _direction(d, f"{option}[{name!r}]") for name, d in value.items()}
+    return _direction(value, option)
+
+
+def _direction(value, option):
+    try:
+        d = np.asarray(value, dtype=np.float64).reshape(3)
+    except (TypeError, ValueError):
+        raise InputError(f"{option} must be a 3D direction (x, y, z), got {value!r}") from None
+    if not np.all(np.isfinite(d)) or not np.any(d):
+        raise InputError(f"{option} must be a non-zero 3D direction, got {value!r}")
+    return tuple(float(x) for x in d)
+
+
+def _ease(value, option):
+    items = [value] if isinstance(value, Ease) else value
+    try:
+        items = tuple(items)
+    except TypeError:
+        raise InputError(f"{option} must be a patterns.Ease or a sequence of them, got {type(value).__name__}") from None
+    for item in items:
+        if not isinstance(item, Ease):
+            raise InputError(f"{option} must be a patterns.Ease or a sequence of them, got a {type(item).__name__}")
+    return items
+
+
+@dataclass(frozen=True, repr=False)
+class FlattenOptions(Options):
+    """How :func:`patterns.flatten` lays a model's panels flat (``patterns flatten``, ``check``, ``batch``)."""
+
+    method: str = option("relaxed", "the mesh engine for freeform panels: relaxed (the greedy start relaxed to "
+                                    "the least strain, always one-to-one: for patterns), isometric (the greedy "
+                                    "grower alone) or conformal (the paper as written)", choices=METHODS)
+    exact: bool = option(True, "unroll planar, cylindrical and conical CAD faces analytically (exact, strain 0); "
+                               "the command line's --no-exact sends them through the mesh engine too")
+    thickness: float = option(0.0, "sheet thickness, mm: develop the neutral surface, k_factor x thickness from "
+                                   "the inside skin", low=0, metavar="MM")
+    k_factor: float = option(0.5, "position of the neutral surface from the inside skin, 0..1", low=0, high=1,
+                             metavar="K")
+    reference: str = option("mid", "which skin of the sheet the model shows", choices=REFERENCES)
+    grain: object = option(None, "a 3D direction to point along +Y on every panel (fabric grain, rolling "
+                                 "direction), or (API) a mapping of panel names to directions",
+                           check=_grain, parse=parse_direction, metavar="X,Y,Z")
+    seams: str = option("true", "relaxed: hold every seam edge at its 3D length (true), each seam side's total "
+                                "length (total), or nothing (free)", choices=tuple(m.value for m in SeamLengths))
+    ease: object = option(None, "deliberate extra length on one side of a seam (patterns.Ease; on the command "
+                                "line SEAM:PANEL:MM or SEAM:PANEL:PERCENT%, repeatable)",
+                          check=_ease, parse=parse_ease, repeat=True, metavar="SEAM:PANEL:AMOUNT")
+    max_strain: float | None = option(None, "cut darts into a freeform panel whose triangle strain is above this "
+                                            "ratio (0.03 = 3 %), one at a time, up to max_darts",
+                                      low=0, low_open=True, optional=True, flag="--dart-strain", metavar="R")
+    max_darts: int = option(60, "at most this many darts per panel", low=0, integer=True, metavar="N")
+    max_iterations: int = option(500, "relaxed: at most this many relaxation iterations", low=0, low_open=True,
+                                 integer=True, metavar="N")
+    energy_tolerance: float = option(1e-6, "relaxed: stop when the energy falls by less than this fraction per "
+                                           "iteration", low=0, metavar="R")
+    min_stretch: float | None = option(None, "relaxed: keep every triangle at least this fraction of its size in "
+                                             "every direction, 0..1", low=0, high=1, low_open=True,
+                                       high_open=True, optional=True, metavar="R")
+    energy: str = option("auto", "relaxed: the distortion minimised (auto: ARAP, the squared principal strains, "
+                                 "or the hybrid where ARAP would press triangles flat)", choices=ENERGIES)
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.method != "relaxed":
+            for name in ("ease", "min_stretch"):
+                if getattr(self, name) is not None:
+                    raise InputError(f"{name} applies to method='relaxed' only")
+            if self.energy != "auto":
+                raise InputError("energy applies to method='relaxed' only")
+        if self.ease and self.seams == "free":
+            raise InputError("ease needs seams='true' or 'total'")
