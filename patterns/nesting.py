@@ -9,13 +9,25 @@ along +Y from y = 0, ``width`` wide (x from 0 to ``width``).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
 from .errors import InputError, LayoutError
 from .options import check_number
 
-__all__ = ["Layout", "LayoutError", "layout"]
+__all__ = ["Layout", "LayoutError", "Placeable", "layout"]
+
+
+class Placeable(Protocol):
+    """What :func:`layout` needs of a pattern (:class:`patterns.Pattern` is one): its name, its flat
+    panels, and a copy with the panels placed.  A protocol rather than an import, because
+    ``Pattern.layout()`` calls this module."""
+
+    name: str
+    panels: tuple
+
+    def placed(self, placements) -> Placeable: ...
 
 
 @dataclass(frozen=True, eq=False)
@@ -37,7 +49,7 @@ class Layout:
         The panels' flat area, mm^2.
     """
 
-    pattern: object
+    pattern: Placeable
     width: float
     length: float
     area_used: float

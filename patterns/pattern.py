@@ -9,13 +9,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
 
 from .errors import InputError
 from .measure import TriangleStrain, flat_direction, no_strain, triangle_strains
-from .model import SurfaceKind
+from .model import Model, Panel, Seam, SurfaceKind
+
+if TYPE_CHECKING:  # the engine imports this module; the annotation only names its result type
+    from .flattening.engine import Flattening
 
 __all__ = ["FlatPanel", "FlatSeam", "Pattern"]
 
@@ -34,8 +38,8 @@ class FlatPanel:
     """
 
     name: str
-    panel: object
-    flattening: object
+    panel: Panel
+    flattening: Flattening
     placement: tuple = (0.0, 0.0, 0.0)
     darts: tuple = ()
     """Cuts made by ``flatten(..., max_strain=...)``: each a ``(k,)`` int64 path of
@@ -219,7 +223,7 @@ class FlatSeam:
         3D length of its polyline times its ease, mm; None for a free seam.
     """
 
-    seam: object
+    seam: Seam
     flat_lengths: tuple
     held_lengths: tuple | None = None
 
@@ -249,7 +253,7 @@ class Pattern:
         The flattening method used.
     """
 
-    model: object
+    model: Model
     panels: tuple
     seams: tuple
     method: str

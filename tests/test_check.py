@@ -276,3 +276,85 @@ def test_heat_map_colours_a_known_strain(tmp_path, stretch, expected, opposite):
 
     assert share(expected) > 0.05  # the panel (and the end of the colour bar)
     assert share(expected) > 20 * share(opposite)  # the other end only on the colour bar
+
+
+# --------------------------------------------------------------------------- #
+# Every finding code, produced (issue 17: codes no test made)
+# --------------------------------------------------------------------------- #
+
+
+def _with_uv(pattern, index, uv):
+    """The pattern with panel ``index`` laid at ``uv`` instead (its overlap verdict recomputed)."""
+    from dataclasses import replace
+
+    flat = pattern.panels[index]
+    moved = replace(flat.flattening, uv=uv, overlap=patterns.overlap_verdict(flat.faces, uv, flat.loops))
+    panels = list(pattern.panels)
+    panels[index] = replace(flat, flattening=moved)
+    return replace(pattern, panels=tuple(panels))
+
+
+@pytest.fixture(scope="module")
+def holed():
+    """A plate with a round hole through it: (pattern, index of a panel with a hole)."""
+    import build123d as bd
+
+    pattern = patterns.flatten(patterns.load(bd.Box(200, 100, 50) - bd.Cylinder(20, 50), max_edge=10))
+    return pattern, next(i for i, flat in enumerate(pattern.panels) if len(flat.loops) == 2)
+
+
+def _codes(pattern):
+    return {f.code for f in patterns.check(pattern).findings}
+
+
+def test_outline_crossing_itself_is_a_finding():
+    from patterns.reading import mesh_model
+
+    st, f = surfaces.grid_mesh(60, 4)
+    s_, t_ = st[:, 0] * 600.0, st[:, 1] * 20.0
+    strip = patterns.flatten(mesh_model(np.column_stack([s_, t_, np.zeros(len(st))]), f), method="isometric")
+    angle, radius = s_ / 600.0 * 2.4 * np.pi, 100.0 + t_  # bent round past a full turn: the ends cross
+    bent = _with_uv(strip, 0, np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
+    assert Code.OUTLINE_CROSSES_ITSELF in _codes(bent) and Code.OUTLINE_CROSSES_ITSELF not in _codes(strip)
+
+
+def test_a_mirrored_panel_is_inside_out(cup):
+    uv = np.array(cup.panels[0].uv) * [-1.0, 1.0]  # a mirror image: the outline runs clockwise
+    codes = _codes(_with_uv(cup, 0, uv))
+    assert Code.INSIDE_OUT in codes and Code.INSIDE_OUT not in _codes(cup)
+
+
+@pytest.mark.parametrize(("shift", "code"), [(1000.0, Code.HOLE_OUTSIDE_OUTLINE),
+                                             (None, Code.HOLE_CROSSES_OUTLINE)])
+def test_a_misplaced_hole_is_a_finding(holed, shift, code):
+    pattern, i = holed
+    flat = pattern.panels[i]
+    uv = np.array(flat.uv)
+    hole = flat.loops[1]
+    centre = uv[hole].mean(axis=0)
+    if shift is None:  # the hole's centre onto the outline: it straddles the edge
+        outline = uv[flat.loops[0]]
+        shift = outline[np.argmin(np.linalg.norm(outline - centre, axis=1))][0] - centre[0]
+        uv[hole] += [shift, outline[np.argmin(np.linalg.norm(outline - centre, axis=1))][1] - centre[1]]
+    else:
+        uv[hole] += [shift, 0.0]
+    assert code in _codes(_with_uv(pattern, i, uv))
+    assert code not in _codes(pattern)
+
+
+def test_a_relaxation_stopped_early_is_a_note(cup):
+    short = patterns.flatten(cup.model, max_iterations=2)
+    found = [f for f in patterns.check(short).findings if f.code is Code.NOT_CONVERGED]
+    assert found and all(f.severity is Severity.NOTE for f in found)
+    assert Code.NOT_CONVERGED not in _codes(cup)
+
+
+def test_every_finding_code_is_produced_by_a_test():
+    """Each Code appears in some test of this suite (besides this one)."""
+    import pathlib
+
+    here = pathlib.Path(__file__).parent
+    text = "".join(p.read_text() for p in here.glob("test_*.py")).replace(
+        test_every_finding_code_is_produced_by_a_test.__doc__, "")
+    missing = [c.name for c in Code if f"Code.{c.name}" not in text]  # Code.X or patterns.Code.X
+    assert not missing, missing

@@ -341,3 +341,105 @@ def test_readers_are_present_in_ci():
         pytest.skip("PATTERNS_READERS is empty (only .ci/run installs the real readers)")
     missing = [tool for tool, package in PACKAGES.items() if package in packages and shutil.which(tool) is None]
     assert not missing, f"readers installed by .ci/run but missing: {missing}"
+
+
+# --------------------------------------------------------------------------- #
+# Planted-bug guards: notch directions, units, true scale (issue 17, point 9)
+# --------------------------------------------------------------------------- #
+
+
+def _polygons(doc, layer):
+    return [shapely.Polygon(pts) for pts, closed in polylines(doc, layer) if closed]
+
+
+def test_notch_slits_cut_into_the_allowance_never_into_the_piece(cup, tmp_path):
+    """Every slit runs from the seam line out to the cut line, through the seam allowance: its
+    middle lies inside the cut contour and outside every seam line (a slit flipped inwards would
+    cut the finished piece)."""
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, seam_allowance=10.0)
+    doc = read(path)
+    cut, sew = shapely.union_all(_polygons(doc, "CUT")), shapely.union_all(_polygons(doc, "SEW"))
+    lines = doc.modelspace().query('LINE[layer=="NOTCH"]')
+    assert len(lines) == 2 * 2 * len(cup.seams)
+    for line in lines:
+        a, b = np.array(line.dxf.start)[:2], np.array(line.dxf.end)[:2]
+        assert sew.boundary.distance(shapely.Point(a)) < 1e-6  # starts on the seam line
+        assert cut.boundary.distance(shapely.Point(b)) < 1e-6  # ends on the cut line
+        mid = shapely.Point((a + b) / 2)
+        assert cut.contains(mid) and not sew.contains(mid)
+
+
+def test_astm_notches_point_into_the_piece(cup, tmp_path):
+    """An ASTM notch is a POINT on the cut line whose angle (group 50) points into the piece,
+    as deep as the allowance: base + depth x direction lands on the seam line."""
+    path = tmp_path / "cup_astm.dxf"
+    cup.to_dxf(path, profile="astm", seam_allowance=10.0)
+    doc = read(path)
+    for insert in doc.modelspace().query("INSERT"):
+        block = doc.blocks[insert.dxf.name]
+        (cut,) = [e for e in block.query("POLYLINE") if e.dxf.layer == "1"]
+        (sew,) = [e for e in block.query("POLYLINE") if e.dxf.layer == "14"]
+        cut_poly = shapely.Polygon([tuple(v.dxf.location)[:2] for v in cut.vertices])
+        sew_poly = shapely.Polygon([tuple(v.dxf.location)[:2] for v in sew.vertices])
+        for point in block.query('POINT[layer=="4"]'):
+            base = np.array(point.dxf.location)[:2]
+            depth = point.dxf.location.z
+            direction = np.array([np.cos(np.radians(point.dxf.angle)), np.sin(np.radians(point.dxf.angle))])
+            assert cut_poly.exterior.distance(shapely.Point(base)) < 1e-6
+            assert cut_poly.contains(shapely.Point(base + 0.5 * depth * direction))  # into the piece
+            assert sew_poly.exterior.distance(shapely.Point(base + depth * direction)) < 1e-6
+
+
+@pytest.mark.parametrize("units", ["mm", "cm", "m", "in"])
+def test_other_units_end_to_end(tmp_path, units):
+    """A mesh in inches (or cm, m) read with --units, written in the same unit: the DXF's outline
+    area, in that unit squared, is the mesh's own area computed from the file's numbers; the header
+    says the unit (INSUNITS 1/4/5/6, MEASUREMENT 0 for inches) and the label says it too."""
+    import trimesh
+
+    from patterns import cli
+
+    from patterns import surfaces
+
+    # A whole turn of a cylinder (numbers in `units`): it is cut open, and the cut is a seam with a label.
+    v, f = surfaces.cylinder_patch(radius=2.0, height=5.0, angle=360.0, n_around=40, n_along=8)
+    v, f = _welded(v, f)
+    mesh_path = tmp_path / "tube.obj"
+    trimesh.Trimesh(v, f, process=False).export(mesh_path)
+    file_v = trimesh.load(mesh_path, process=False).vertices
+    p = file_v[f]
+    area_3d = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum()
+    out = tmp_path / "tube.dxf"
+    assert cli.main(["flatten", str(mesh_path), "-o", str(out), "--units", units]) == 0
+    doc = read(out)
+    assert doc.header["$INSUNITS"] == patterns.Unit(units).insunits
+    assert doc.header["$MEASUREMENT"] == (0 if units == "in" else 1)
+    (outline,) = _polygons(doc, "CUT")
+    assert outline.area == pytest.approx(area_3d, rel=1e-6)  # a cylinder unrolls without strain
+    assert not outline.area == pytest.approx(area_3d * 25.4**2, rel=0.5)
+    labels = [t.dxf.text.split() for t in doc.modelspace().query("TEXT") if t.dxf.text.startswith("S0 ")]
+    assert labels and all(words[-1] == patterns.Unit(units).label for words in labels)  # "S0 3D ... FLAT ... IN"
+
+
+def test_true_scale_against_independent_lengths(cup, tmp_path):
+    """1:1 checked with numbers computed here, not by patterns: each flat outline's area (shapely)
+    against the 3D area (cross products), each seam side's flat length against the 3D polyline of
+    its points.  A pattern scaled by 1.5 fails both; one scaled by 1.001 fails the seams."""
+    for flat in cup.panels:
+        p = flat.vertices[flat.faces]
+        area_3d = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum()
+        area_flat = shapely.Polygon(flat.uv[flat.loops[0]]).area
+        assert abs(area_flat / area_3d - 1) < 0.05  # a sphere's quarter pressed flat: -2.9 % of its area
+    for fs in cup.seams:
+        length_3d = np.linalg.norm(np.diff(fs.seam.points, axis=0), axis=1).sum()
+        for side, (panel, idx) in enumerate(zip(fs.seam.panels, fs.seam.vertices)):
+            uv = cup.panels[panel].uv[np.asarray(idx)]
+            flat_length = np.linalg.norm(np.diff(uv, axis=0), axis=1).sum()
+            assert flat_length == pytest.approx(length_3d, rel=2e-4), (fs.seam.id, side)
+
+
+def _welded(v, f):
+    """The mesh with vertices at the same coordinates (the seam of a whole turn) made one."""
+    _, index, inverse = np.unique(np.round(v, 9), axis=0, return_index=True, return_inverse=True)
+    return v[index], inverse.ravel()[f]

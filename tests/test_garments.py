@@ -166,7 +166,7 @@ def test_darts_relieve_a_hemisphere_and_never_leave_it_worse():
     # The report agrees, lists the darts, and flags what is still above the limit.
     report = patterns.check(patterns.flatten(model, max_strain=0.03), max_strain=0.03)
     assert report.panels[0].darts == len(flat.darts)
-    (note,) = [f for f in report.findings if f.code.value == "darts"]
+    (note,) = [f for f in report.findings if f.code is patterns.Code.DARTS]
     assert len(note.points) == len(flat.darts)
     assert report.panels[0].strain_max == pytest.approx(after.max(), rel=1e-6)
     assert not report.ok

@@ -103,7 +103,7 @@ class DxfOptions(Options):
     profile: str = option("machine", "DXF dialect: machine (laser, plasma, waterjet, knife plotter: layers CUT, "
                                      "SEW, NOTCH, GRAIN, BEND, LABEL) or astm (garment CAD: ASTM D6673, R12, one "
                                      "block per piece); see docs/dxf.md", choices=PROFILES)
-    seam_allowance: object = option(0.0, "seam allowance added outside the seam line, mm: one number for every "
+    seam_allowance: float | dict = option(0.0, "seam allowance added outside the seam line, mm: one number for every "
                                          "edge, or (API) a mapping {seam id: mm, None: mm for every other edge}; "
                                          "the seam line then goes on SEW (ASTM layer 14)",
                                     check=_seam_allowance, parse=float, metavar="MM")
@@ -316,7 +316,7 @@ def _readable_angle(direction) -> float:
     return angle
 
 
-def _seam_annotations(pattern, geo):
+def _seam_annotations(pattern, geo, unit: Unit = Unit.MM):
     """``(text, position (2,), angle degrees)`` for every seam side on the panel, at its middle, inside."""
 
     out = []
@@ -333,14 +333,19 @@ def _seam_annotations(pattern, geo):
             at = pts[mid] + 1.6 * geo.text_height * normal
             if not shapely.contains_xy(geo.polygon, *at):
                 at = pts[mid] - 1.6 * geo.text_height * normal
-            text = seam_label(fs, side)
+            text = seam_label(fs, side, unit)
             out.append((text, at, _readable_angle(tangent)))
     return out
 
 
-def seam_label(flat_seam, side: int) -> str:
-    """The annotation written next to a seam: id, 3D length and this side's flat length (0.01 mm)."""
-    return (f"S{flat_seam.seam.id} 3D {flat_seam.length:.2f} FLAT {flat_seam.flat_lengths[side]:.2f} MM")
+def seam_label(flat_seam, side: int, unit: Unit = Unit.MM) -> str:
+    """The annotation written next to a seam: id, 3D length and this side's flat length, in the drawing's unit.
+
+    Two decimals in mm, four in the larger units (0.01 mm or finer either way).
+    """
+    digits = 2 if unit is Unit.MM else 4
+    length, flat = flat_seam.length / unit.mm, flat_seam.flat_lengths[side] / unit.mm
+    return f"S{flat_seam.seam.id} 3D {length:.{digits}f} FLAT {flat:.{digits}f} {unit.label}"
 
 
 def notch_positions(flat_seam, side: int, uv: np.ndarray, spacing: float | None) -> list:
@@ -499,7 +504,7 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
         text(g.name, g.label_at + [0.0, 0.8 * g.text_height], 1.2 * g.text_height)
         text(f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%",
              g.label_at - [0.0, 0.9 * g.text_height], 0.7 * g.text_height)
-        for s, at, angle in _seam_annotations(pattern, g):
+        for s, at, angle in _seam_annotations(pattern, g, unit):
             text(s, at, 0.6 * g.text_height, angle)
         if bend_spacing is not None:
             for a, b, turn in pattern.panels[g.index].rulings(bend_spacing):

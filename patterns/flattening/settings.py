@@ -90,12 +90,12 @@ class FlattenOptions(Options):
     k_factor: float = option(0.5, "position of the neutral surface from the inside skin, 0..1", low=0, high=1,
                              metavar="K")
     reference: str = option("mid", "which skin of the sheet the model shows", choices=REFERENCES)
-    grain: object = option(None, "a 3D direction to point along +Y on every panel (fabric grain, rolling "
+    grain: tuple | dict | None = option(None, "a 3D direction to point along +Y on every panel (fabric grain, rolling "
                                  "direction), or (API) a mapping of panel names to directions",
                            check=_grain, parse=parse_direction, metavar="X,Y,Z")
     seams: str = option("true", "relaxed: hold every seam edge at its 3D length (true), each seam side's total "
                                 "length (total), or nothing (free)", choices=tuple(m.value for m in SeamLengths))
-    ease: object = option(None, "deliberate extra length on one side of a seam (patterns.Ease; on the command "
+    ease: tuple | None = option(None, "deliberate extra length on one side of a seam (patterns.Ease; on the command "
                                 "line SEAM:PANEL:MM or SEAM:PANEL:PERCENT%, repeatable)",
                           check=_ease, parse=parse_ease, repeat=True, metavar="SEAM:PANEL:AMOUNT")
     max_strain: float | None = option(None, "cut darts into a freeform panel whose triangle strain is above this "

@@ -1,0 +1,190 @@
+"""Topology: a B-rep's faces, edges and wires, numbered once; sewing; the panel groups.
+
+The first stage of :func:`patterns.tessellate.mesh_shape`: everything later
+refers to faces and edges by these numbers (build123d's ``shape.faces()`` and
+``shape.edges()`` order).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import CadError, InputError
+
+__all__ = ["Topology", "panel_groups", "read_topology", "sewn"]
+
+
+class _Registry:
+    """Unique sub-shapes (edges, vertices) by identity, in first-seen order."""
+
+    def __init__(self):
+        self.items = []
+        self._by_hash = {}
+
+    def index(self, item) -> int:
+        bucket = self._by_hash.setdefault(hash(item), [])
+        for i in bucket:
+            if self.items[i].IsSame(item):
+                return i
+        self.items.append(item)
+        bucket.append(len(self.items) - 1)
+        return len(self.items) - 1
+
+
+@dataclass(frozen=True, eq=False)
+class Topology:
+    """The faces, edges and wires of a shape.
+
+    Attributes
+    ----------
+    name : str
+        The shape's name, for messages.
+    faces : tuple of OCP ``TopoDS_Face``
+        In build123d's ``shape.faces()`` order.
+    edges : tuple of OCP ``TopoDS_Edge``
+        In ``shape.edges()`` order; degenerate edges (a sphere's pole, a
+        cone's apex) after all the others.
+    degenerate : tuple of bool
+        Per edge.
+    wires : tuple
+        Per face, its wires; each a tuple of ``(edge index, oriented edge)``
+        in the order the wire walks them on the face.
+    edge_faces : tuple
+        Per edge, the faces whose wires use it (a face twice along its own
+        seam line).
+    """
+
+    name: str
+    faces: tuple
+    edges: tuple
+    degenerate: tuple
+    wires: tuple
+    edge_faces: tuple
+
+
+def read_topology(shape, *, name: str) -> Topology:
+    """Number the faces, edges and wires of an OCP shape; CadError if it has no faces."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepTools import BRepTools_WireExplorer
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_WIRE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    faces = []
+    seen = _Registry()
+    ex = TopExp_Explorer(shape, TopAbs_FACE)
+    while ex.More():
+        face = TopoDS.Face(ex.Current())
+        if seen.index(face) == len(faces):
+            faces.append(face)
+        ex.Next()
+    if not faces:
+        raise CadError(f"{name}: the shape has no faces (nothing to flatten)")
+    # Edges numbered as build123d's ``shape.edges()`` does: explorer order,
+    # degenerate edges left out -- here they come after all the others.
+    edges = _Registry()
+    ex = TopExp_Explorer(shape, TopAbs_EDGE)
+    while ex.More():
+        edge = TopoDS.Edge(ex.Current())
+        if not BRep_Tool.Degenerated_s(edge):
+            edges.index(edge)
+        ex.Next()
+    wires = []
+    for face in faces:
+        walks = []
+        wx = TopExp_Explorer(face, TopAbs_WIRE)
+        while wx.More():
+            walk = []
+            we = BRepTools_WireExplorer(TopoDS.Wire(wx.Current()), face)
+            while we.More():
+                edge = we.Current()
+                walk.append((edges.index(edge), edge))
+                we.Next()
+            if walk:
+                walks.append(tuple(walk))
+            wx.Next()
+        wires.append(tuple(walks))
+    edge_faces = [[] for _ in edges.items]
+    for k, walks in enumerate(wires):
+        for walk in walks:
+            for e, _ in walk:
+                edge_faces[e].append(k)
+    return Topology(name=name, faces=tuple(faces), edges=tuple(edges.items),
+                    degenerate=tuple(bool(BRep_Tool.Degenerated_s(e)) for e in edges.items),
+                    wires=tuple(wires), edge_faces=tuple(tuple(f) for f in edge_faces))
+
+
+def panel_groups(topology: Topology, groups) -> tuple:
+    """Panels as ``(name, face indices)``: the user's groups first (checked), then one per remaining face."""
+    n = len(topology.faces)
+    panels, taken = [], {}
+    for label, idx in (groups or {}).items():
+        for i in idx:
+            if not 0 <= i < n:
+                raise InputError(f"{topology.name}: panels[{label!r}] names CAD face {i}; "
+                                 f"the shape has faces 0..{n - 1}")
+            if i in taken:
+                raise InputError(f"{topology.name}: face {i} is in two groups, {taken[i]!r} and {label!r}")
+            taken[i] = label
+        panels.append((str(label), sorted(set(idx))))
+    panels += [(f"face{i}", [i]) for i in range(n) if i not in taken]
+    return tuple(panels)
+
+
+def sewn(shape, tolerance: float):
+    """The shape with loose faces sewn along common edges, or the shape itself.
+
+    Sewing is tried only when some edge bounds a single face while another
+    edge of the same length and ends does too, i.e. two faces meet there
+    without sharing the edge; the face count must survive the sewing.
+    """
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp, TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    faces = _Registry()
+    ex = TopExp_Explorer(shape, TopAbs_FACE)
+    while ex.More():
+        faces.index(ex.Current())
+        ex.Next()
+    if len(faces.items) < 2:
+        return shape
+    edges = _Registry()
+    owners = []
+    for k, face in enumerate(faces.items):
+        ee = TopExp_Explorer(face, TopAbs_EDGE)
+        while ee.More():
+            i = edges.index(ee.Current())
+            if i == len(owners):
+                owners.append(set())
+            owners[i].add(k)
+            ee.Next()
+    free = []
+    for edge, own in zip(edges.items, owners):
+        edge = TopoDS.Edge(edge)
+        if len(own) != 1 or BRep_Tool.Degenerated_s(edge):
+            continue
+        a = BRep_Tool.Pnt_s(TopExp.FirstVertex_s(edge))
+        b = BRep_Tool.Pnt_s(TopExp.LastVertex_s(edge))
+        free.append(tuple(sorted([(a.X(), a.Y(), a.Z()), (b.X(), b.Y(), b.Z())])))
+    if len(free) < 2:
+        return shape
+    ends = np.array([np.r_[p, q] for p, q in free])
+    close = np.linalg.norm(ends[:, None, :] - ends[None, :, :], axis=2) <= 2 * tolerance
+    np.fill_diagonal(close, False)
+    if not close.any():
+        return shape
+    sewing = BRepBuilderAPI_Sewing(tolerance)
+    sewing.Add(shape)
+    sewing.Perform()
+    sewn = sewing.SewedShape()
+    count = 0
+    ex = TopExp_Explorer(sewn, TopAbs_FACE)
+    while ex.More():
+        count += 1
+        ex.Next()
+    return sewn if count == len(faces.items) else shape
