@@ -398,9 +398,7 @@ def test_other_units_end_to_end(tmp_path, units):
     says the unit (INSUNITS 1/4/5/6, MEASUREMENT 0 for inches) and the label says it too."""
     import trimesh
 
-    from patterns import cli
-
-    from patterns import surfaces
+    from patterns import cli, surfaces
 
     # A whole turn of a cylinder (numbers in `units`): it is cut open, and the cut is a seam with a label.
     v, f = surfaces.cylinder_patch(radius=2.0, height=5.0, angle=360.0, n_around=40, n_along=8)
