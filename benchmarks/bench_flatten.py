@@ -459,7 +459,7 @@ def measure(row: Row, vertices, faces, uv, loops) -> Row:
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         fill(row, patterns.distortion(vertices, faces, uv, loops=loops))
     if loops is not None:
-        row.one_to_one = patterns.overlap_verdict(faces, uv, loops).one_to_one
+        row.one_to_one = patterns.overlap_verdict(uv, faces, loops).one_to_one
     return row
 
 
@@ -665,7 +665,7 @@ def _mirror_if_reversed(faces: np.ndarray, uv: np.ndarray, row: Row) -> np.ndarr
 
 def _init_note(faces: np.ndarray, init: np.ndarray, init_seconds: float) -> str:
     """Note on the harmonic initialisation: its time and, if any, its folded triangles."""
-    folded = len(folded_faces(faces, init))
+    folded = len(folded_faces(init, faces))
     return f"harmonic init {init_seconds:.3f} s" + (f" ({folded} folded)" if folded else "")
 
 

@@ -64,7 +64,7 @@ def main(argv=None) -> int:
         v, f, conn = validate_mesh(panel.vertices, panel.faces)
         free, layouts = starts(v, f, conn)
         base = strain_rms(v, f, free.uv)
-        greedy_ok = patterns.overlap_verdict(f, layouts["greedy"][0], conn.loops).one_to_one
+        greedy_ok = patterns.overlap_verdict(layouts["greedy"][0], f, conn.loops).one_to_one
         print(f"| {name} | free | free optimum | {100 * base:.4f} | 1 | - | yes | {free.iterations} |")
         for mode in (SeamLengths.TOTAL, SeamLengths.TRUE):
             held = held_lengths(model, index, v, {}, mode, mesh_edges=unique_edges(f))
@@ -74,7 +74,7 @@ def main(argv=None) -> int:
                 r = relax.relax(v, f, conn, np.array(uv), lengths=held, tolerance=1e-9, max_iterations=5000,
                                 barrier=barrier)
                 rms = strain_rms(v, f, r.uv)
-                ok = patterns.overlap_verdict(f, r.uv, conn.loops).one_to_one
+                ok = patterns.overlap_verdict(r.uv, f, conn.loops).one_to_one
                 print(f"| {name} | {mode.value} | {start} | {100 * rms:.4f} | {rms / base:.4f} | "
                       f"{r.length_error:.1e} | {'yes' if ok else 'no'} | {r.iterations} |", flush=True)
     return 0

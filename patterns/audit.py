@@ -377,7 +377,7 @@ def _panel_overlaps(flat) -> list:
     """Findings for one panel overlapping itself: folds, crossing loops, misplaced holes."""
     uv, faces, loops, name = flat.uv, flat.faces, flat.loops, flat.name
     out = []
-    folded = folded_faces(faces, uv)
+    folded = folded_faces(uv, faces)
     none = np.zeros(0, dtype=np.int64)
     if len(folded):
         centres = uv[faces[folded]].mean(axis=1)

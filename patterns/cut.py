@@ -23,7 +23,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from .errors import MeshTopologyError
-from .mesh import _readonly, check_boundary_vertices, corner_angles, edge_lengths, edge_tables, trace_loops
+from .mesh import _readonly, as_mesh_arrays, check_boundary_vertices, corner_angles, edge_lengths, edge_tables, trace_loops
 
 __all__ = ["Cut", "cut_along", "cut_to_disk", "pieces"]
 
@@ -125,6 +125,7 @@ def cut_to_disk(vertices: np.ndarray, faces: np.ndarray, *, name: str = "mesh") 
         A closed surface or tube with handles (genus > 0), which one cut cannot
         open; or a cut that could not be routed.
     """
+    vertices, faces = as_mesh_arrays(vertices, faces, name=name)  # array_like in; checked shapes and values
     n, m = len(vertices), len(faces)
     t = edge_tables(faces, n, name=name)
     check_boundary_vertices(t, n, name=name)

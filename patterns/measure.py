@@ -126,17 +126,19 @@ def _stretches(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     return np.stack([a + b, np.abs(a - b)], axis=1)
 
 
-def signed_areas(faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
-    """Signed flat areas ``(m,) float64`` (positive = counter-clockwise)."""
+def signed_areas(uv: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Signed flat areas ``(m,) float64`` of triangles ``faces`` (m, 3) over flat points ``uv`` (n, 2) (positive =
+    counter-clockwise), in the square of ``uv``'s unit."""
+    uv, faces = np.asarray(uv, dtype=np.float64), np.asarray(faces, dtype=np.int64)
     x, y = uv[:, 0], uv[:, 1]
     i, j, k = faces[:, 0], faces[:, 1], faces[:, 2]
     x0, y0 = x[i], y[i]
     return 0.5 * ((x[j] - x0) * (y[k] - y0) - (y[j] - y0) * (x[k] - x0))
 
 
-def folded_faces(faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
-    """Indices ``(k,) int64`` of the triangles whose flat signed area is <= 0."""
-    return np.flatnonzero(~(signed_areas(faces, uv) > 0))
+def folded_faces(uv: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Indices ``(k,) int64`` of the triangles ``faces`` (m, 3) whose signed area over ``uv`` (n, 2) is <= 0."""
+    return np.flatnonzero(~(signed_areas(uv, faces) > 0))
 
 
 def edge_strain(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, edges: np.ndarray | None = None) -> np.ndarray:
@@ -164,7 +166,7 @@ def edge_strain(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, edge
 
 def area_ratio(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> np.ndarray:
     """Signed flat area over 3D area, per triangle ``(m,) float64``."""
-    return signed_areas(faces, uv) / face_areas(vertices, faces)
+    return signed_areas(uv, faces) / face_areas(vertices, faces)
 
 
 def boundary_lengths(vertices: np.ndarray, uv: np.ndarray, loops) -> np.ndarray:
@@ -250,7 +252,7 @@ def distortion(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, *, loops
         strain = edge_strain(vertices, faces, uv)
         sigma = principal_stretches(vertices, faces, uv)
         a3 = face_areas(vertices, faces)
-        sa = signed_areas(faces, uv)
+        sa = signed_areas(uv, faces)
         if loops is None:
             b3 = bf = float("nan")
         else:
@@ -337,7 +339,7 @@ def triangle_strains(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) ->
     angle = 0.5 * (np.angle(alpha) + np.angle(beta)) + np.where(first, 0.0, 0.5 * np.pi)
     direction = np.mod(angle, np.pi)
     a3 = face_areas(vertices, faces)
-    change = signed_areas(faces, uv) / a3 - 1.0
+    change = signed_areas(uv, faces) / a3 - 1.0
     arrays = [stretch, strain, dominant, direction, change, a3]
     for x in arrays:
         x.setflags(write=False)
@@ -379,7 +381,7 @@ def symmetric_dirichlet(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray)
     measure, which sees crushed triangles that the strain RMS hardly notices.
     """
     sigma = principal_stretches(vertices, faces, uv)
-    if np.any(~(signed_areas(faces, uv) > 0)):
+    if np.any(~(signed_areas(uv, faces) > 0)):
         return float("inf")
     a3 = face_areas(vertices, faces)
     return _symmetric_dirichlet(sigma, a3 / a3.sum())

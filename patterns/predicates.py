@@ -55,15 +55,15 @@ class Overlap:
         return len(self.folded)
 
 
-def overlap_verdict(faces: np.ndarray, uv: np.ndarray, loops) -> Overlap:
+def overlap_verdict(uv: np.ndarray, faces: np.ndarray, loops) -> Overlap:
     """Decide whether the flat mesh ``(uv, faces)`` overlaps itself.
 
     Parameters
     ----------
-    faces : (m, 3) int64
-    uv : (n, 2) float64
+    uv : array_like, (n, 2) float
         Flat positions (any unit).
-    loops : sequence of (k,) int64 arrays
+    faces : array_like, (m, 3) int
+    loops : sequence of array_like (k,) int
         Boundary loops of the mesh, the surface to their left
         (:attr:`patterns.mesh.Connectivity.loops`).
 
@@ -72,12 +72,14 @@ def overlap_verdict(faces: np.ndarray, uv: np.ndarray, loops) -> Overlap:
     Overlap
     """
     # A diverged flattening overflows here; its verdict is still exact.
+    uv, faces = np.asarray(uv, dtype=np.float64), np.asarray(faces, dtype=np.int64)
+    loops = [np.asarray(loop, dtype=np.int64) for loop in loops]
     with np.errstate(over="ignore", invalid="ignore"):
-        return _verdict(faces, uv, loops)
+        return _verdict(uv, faces, loops)
 
 
-def _verdict(faces: np.ndarray, uv: np.ndarray, loops) -> Overlap:
-    folded = folded_faces(faces, uv)
+def _verdict(uv: np.ndarray, faces: np.ndarray, loops) -> Overlap:
+    folded = folded_faces(uv, faces)
     folded.setflags(write=False)
     problems = []
     if len(folded):

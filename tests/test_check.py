@@ -141,11 +141,11 @@ def test_folded_flattening_is_caught_with_the_triangles_named(cup):
     broken = patterns.flatten_mesh(flat.vertices, flat.faces, method="isometric")
     from dataclasses import replace
 
-    folded_result = replace(broken, uv=uv, overlap=patterns.overlap_verdict(flat.faces, uv, flat.loops))
+    folded_result = replace(broken, uv=uv, overlap=patterns.overlap_verdict(uv, flat.faces, flat.loops))
     bad = replace(cup, panels=(replace(flat, flattening=folded_result),) + cup.panels[1:])
     report = patterns.check(bad)
     (finding,) = [f for f in report.findings if f.code is Code.FOLDED_TRIANGLES]
-    expected = np.flatnonzero(patterns.measure.signed_areas(flat.faces, uv) <= 0)
+    expected = np.flatnonzero(patterns.measure.signed_areas(uv, flat.faces) <= 0)
     assert len(expected) > 0 and set(finding.faces.tolist()) == set(expected.tolist())
     assert set(finding.faces.tolist()) <= set(fan.tolist())
     np.testing.assert_allclose(finding.points, uv[flat.faces[expected]].mean(axis=1))
@@ -288,7 +288,7 @@ def _with_uv(pattern, index, uv):
     from dataclasses import replace
 
     flat = pattern.panels[index]
-    moved = replace(flat.flattening, uv=uv, overlap=patterns.overlap_verdict(flat.faces, uv, flat.loops))
+    moved = replace(flat.flattening, uv=uv, overlap=patterns.overlap_verdict(uv, flat.faces, flat.loops))
     panels = list(pattern.panels)
     panels[index] = replace(flat, flattening=moved)
     return replace(pattern, panels=tuple(panels))

@@ -33,7 +33,7 @@ def cap():
     uv = np.array(patterns.flatten_mesh(v, f, method="isometric").uv)
     rng = np.random.default_rng(3)
     uv += rng.normal(scale=0.6, size=uv.shape)
-    assert np.all(patterns.measure.signed_areas(f, uv) > 0)
+    assert np.all(patterns.measure.signed_areas(uv, f) > 0)
     return v, f, conn, uv
 
 

@@ -44,7 +44,7 @@ def test_axis_stretch_gives_those_principal_stretches(flat_disk, sx, sy):
 def test_mirror_image_folds_every_triangle(flat_disk):
     v, f = flat_disk
     uv = v[:, :2] * [-1.0, 1.0]
-    assert len(measure.folded_faces(f, uv)) == len(f)
+    assert len(measure.folded_faces(uv, f)) == len(f)
     d = measure.distortion(v, f, uv)
     assert d.n_folded == len(f)
     assert d.edge_strain_max < 1e-14  # lengths are kept: folding is not strain
@@ -85,3 +85,71 @@ def test_boundary_lengths_of_a_square():
     uv = v[:, :2] * 2
     out = measure.boundary_lengths(v, uv, [np.array([0, 1, 2, 3])])
     np.testing.assert_allclose(out, [[10.0, 20.0]])
+
+
+def _svd_stretches(v, f, uv):
+    """Principal stretches (m, 2), descending, by an SVD of each triangle's 2x2 map (computed here)."""
+    out = np.empty((len(f), 2))
+    for t, (a, b, c) in enumerate(f):
+        e1, e2 = v[b] - v[a], v[c] - v[a]
+        x = e1 / np.linalg.norm(e1)
+        y = e2 - (e2 @ x) * x
+        y /= np.linalg.norm(y)
+        local = np.array([[e1 @ x, e2 @ x], [e1 @ y, e2 @ y]])  # columns: the edges in the triangle's frame
+        flat = np.column_stack([uv[b] - uv[a], uv[c] - uv[a]])
+        out[t] = np.linalg.svd(flat @ np.linalg.inv(local), compute_uv=False)
+    return out
+
+
+def test_the_distortion_summary_against_independent_numbers():
+    """Every field of Distortion recomputed here from an SVD per triangle and plain edge lengths."""
+    rng = np.random.default_rng(11)
+    v, f = surfaces.spherical_cap(radius=100.0, half_angle=40.0, n_faces=400)
+    uv = v[:, :2] * [1.03, 0.98] + rng.normal(scale=0.2, size=(len(v), 2))  # a rough, fold-free layout
+    _, _, conn = validate_mesh(v, f)
+    d = measure.distortion(v, f, uv, loops=conn.loops)
+    s = _svd_stretches(v, f, uv)
+    p = v[f]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    w = area / area.sum()
+    assert d.strain_rms == pytest.approx(np.sqrt(0.5 * w @ ((s - 1) ** 2).sum(axis=1)), rel=1e-9)
+    assert d.strain_max == pytest.approx(np.abs(s - 1).max(), rel=1e-9)
+    assert d.symmetric_dirichlet == pytest.approx(w @ (s**2 + s**-2).sum(axis=1), rel=1e-9)
+    order = np.argsort(s[:, 1])
+    p1 = s[order, 1][np.searchsorted(np.cumsum(area[order]), 0.01 * area.sum())]
+    assert d.stretch_p1 == pytest.approx(p1, rel=1e-9)
+    assert d.stretch_min == pytest.approx(s[:, 1].min(), rel=1e-9)
+    assert d.stretch_max == pytest.approx(s[:, 0].max(), rel=1e-9)
+    edges = {tuple(sorted(e)) for t in f for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+    e = np.array(sorted(edges))
+    ratio = np.linalg.norm(uv[e[:, 1]] - uv[e[:, 0]], axis=1) / np.linalg.norm(v[e[:, 1]] - v[e[:, 0]], axis=1)
+    assert d.edge_strain_rms == pytest.approx(np.sqrt(np.mean((ratio - 1) ** 2)), rel=1e-9)
+    assert d.edge_strain_max == pytest.approx(np.abs(ratio - 1).max(), rel=1e-9)
+    assert d.area_3d == pytest.approx(area.sum(), rel=1e-12)
+    q = uv[f]
+    signed = 0.5 * ((q[:, 1, 0] - q[:, 0, 0]) * (q[:, 2, 1] - q[:, 0, 1])
+                    - (q[:, 1, 1] - q[:, 0, 1]) * (q[:, 2, 0] - q[:, 0, 0]))
+    assert d.area_flat == pytest.approx(signed.sum(), rel=1e-12) and d.n_folded == 0 == np.sum(signed <= 0)
+    ring = [np.r_[loop, loop[:1]] for loop in conn.loops]
+    assert d.boundary_3d == pytest.approx(sum(np.linalg.norm(np.diff(v[r], axis=0), axis=1).sum() for r in ring))
+    assert d.boundary_flat == pytest.approx(sum(np.linalg.norm(np.diff(uv[r], axis=0), axis=1).sum() for r in ring))
+    # one triangle folded: counted, and the symmetric Dirichlet energy is infinite
+    folded = uv.copy()
+    tri = f[len(f) // 2]
+    folded[tri[0]] = folded[tri[1]] + folded[tri[2]] - folded[tri[0]]  # reflected across the opposite side
+    df = measure.distortion(v, f, folded)
+    q = folded[f]
+    signed = ((q[:, 1, 0] - q[:, 0, 0]) * (q[:, 2, 1] - q[:, 0, 1]) - (q[:, 1, 1] - q[:, 0, 1]) * (q[:, 2, 0] - q[:, 0, 0]))
+    assert df.n_folded == np.sum(signed <= 0) >= 1 and df.symmetric_dirichlet == float("inf")
+
+
+@pytest.mark.parametrize(("sx", "sy", "angle"), [(1.05, 1.0, 0.0), (1.0, 0.95, np.pi / 2), (1.0, 1.05, np.pi / 2),
+                                                 (0.97, 1.0, 0.0)])
+def test_dominant_strain_direction_is_the_axis_it_acts_along(flat_disk, sx, sy, angle):
+    """A plane stretched (or squeezed) along x or y: the dominant strain's direction is that axis."""
+    v, f = flat_disk
+    ts = measure.triangle_strains(v, f, v[:, :2] * [sx, sy])
+    np.testing.assert_allclose(ts.dominant, (sx - 1) if sx != 1 else (sy - 1), atol=1e-12)
+    dist = np.minimum(np.abs(ts.direction - angle), np.pi - np.abs(ts.direction - angle))
+    assert np.all(dist < 1e-9)
+    assert not ts.direction.flags.writeable and not ts.stretch.flags.writeable

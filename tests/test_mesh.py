@@ -165,3 +165,20 @@ def test_sort_based_unique_matches_numpy():
     # Edges: the sorted unique (low, high) pairs.
     e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
     assert np.array_equal(unique_edges(f), np.unique(e, axis=0))
+
+
+def test_exported_functions_take_plain_lists():
+    """array_like everywhere: lists give the same answers as arrays (vertices first, then faces)."""
+    import trimesh
+
+    v, f = surfaces.spherical_cap(radius=50.0, half_angle=50.0, n_faces=200)
+    r = patterns.flatten_mesh(v.tolist(), f.tolist())
+    np.testing.assert_array_equal(r.uv, patterns.flatten_mesh(v, f).uv)
+    loops = [loop.tolist() for loop in r.loops]
+    assert patterns.overlap_verdict(r.uv.tolist(), f.tolist(), loops).one_to_one
+    assert patterns.distortion(v.tolist(), f.tolist(), r.uv.tolist()).strain_rms == r.distortion.strain_rms
+    ball = trimesh.creation.icosphere(subdivisions=2, radius=10.0)
+    cut = patterns.cut_to_disk(ball.vertices.tolist(), ball.faces.tolist())
+    assert len(cut.paths) == 1 and cut.faces.shape == ball.faces.shape
+    vv, ff, _ = patterns.validate_mesh(v.tolist(), f.tolist())
+    np.testing.assert_array_equal(ff, f)

@@ -42,16 +42,16 @@ def test_flip_free_steps_are_exact():
     rng = np.random.default_rng(5)
     p, f = surfaces.disk_mesh(300)
     step = rng.normal(scale=0.2, size=p.shape)
-    t = flip_free_steps(f, p, step)
+    t = flip_free_steps(p, f, step)
     finite = np.isfinite(t)
     assert finite.any()
     area = patterns.measure.signed_areas
     k = np.flatnonzero(finite)[:50]
-    assert np.all(area(f[k], p) > 0)
+    assert np.all(area(p, f[k]) > 0)
     for i in k:
         tri = f[i:i + 1]
-        assert area(tri, p + 0.999 * t[i] * step)[0] > 0
-        assert area(tri, p + 1.001 * t[i] * step)[0] < 0
+        assert area(p + 0.999 * t[i] * step, tri)[0] > 0
+        assert area(p + 1.001 * t[i] * step, tri)[0] < 0
 
 
 def test_tutte_embedding_is_one_to_one_with_holes_and_true_perimeter():
@@ -65,7 +65,7 @@ def test_tutte_embedding_is_one_to_one_with_holes_and_true_perimeter():
     v = np.column_stack([p, 80.0 * np.sin(p[:, 0] / 100.0)])
     v, f, conn = validate_mesh(v, f)
     uv = tutte_embedding(v, f, conn)
-    assert patterns.overlap_verdict(f, uv, conn.loops).one_to_one
+    assert patterns.overlap_verdict(uv, f, conn.loops).one_to_one
     outer = conn.loops[0]
     radius = np.linalg.norm(uv[outer], axis=1)
     length3d = np.linalg.norm(v[np.roll(outer, -1)] - v[outer], axis=1).sum()
@@ -162,7 +162,7 @@ def _perturbed_cap(*, seed, scale):
     uv = np.array(patterns.flatten_mesh(v, f, method="isometric").uv)
     rng = np.random.default_rng(seed)
     uv += rng.normal(scale=scale, size=uv.shape)
-    assert np.all(patterns.measure.signed_areas(f, uv) > 0)
+    assert np.all(patterns.measure.signed_areas(uv, f) > 0)
     return v, f, conn, uv, rng
 
 

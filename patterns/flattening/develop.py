@@ -165,13 +165,13 @@ def developed(panel, offset: float, name: str) -> Flattening:
     """The exact development of a planar, cylindrical or conical panel (of its offset by ``offset``)."""
     vertices = offset_points(panel.surface, panel.vertices, offset)
     uv = develop(panel.surface, vertices, panel.param, offset=offset)
-    if np.sum(signed_areas(panel.faces, uv)) < 0:
+    if np.sum(signed_areas(uv, panel.faces)) < 0:
         uv[:, 0] = -uv[:, 0]  # the parametrisation runs the other way round: mirror (an isometry)
     if not np.all(np.isfinite(uv)):
         raise FlattenError(f"{name}: the exact development gave non-finite coordinates")
     v, f, conn = validate_mesh(vertices, panel.faces, name=name)
     return Flattening(uv=_readonly(uv), vertices=_readonly(v), faces=_readonly(f), loops=conn.loops,
-                      method="exact", seed_face=-1, overlap=overlap_verdict(f, uv, conn.loops), start="analytic")
+                      method="exact", seed_face=-1, overlap=overlap_verdict(uv, f, conn.loops), start="analytic")
 
 
 def offset_along_normals(panel, offset: float) -> np.ndarray:

@@ -220,7 +220,7 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         uv, seed = np.ascontiguousarray(uv[num.vertex_inverse]), int(num.face[seed])
         loops = tuple(_readonly(num.vertex[loop]) for loop in loops)
     return Flattening(uv=_readonly(uv), vertices=_readonly(v), faces=_readonly(f), loops=loops, method=method,
-                      seed_face=seed, overlap=overlap_verdict(f, uv, loops), **extras)
+                      seed_face=seed, overlap=overlap_verdict(uv, f, loops), **extras)
 
 
 _SCATTERED = 0.25  # share of edges joining vertices more than n / 16 apart in the input's order
@@ -271,7 +271,7 @@ def _engine(v, f, conn, seed, method, pins, lengths, progress, name, **relax_opt
     # Beyond ~1e154 the flat triangles' areas overflow double precision: such a
     # result cannot even be checked, so it is an error, not an answer.
     with np.errstate(over="ignore", invalid="ignore"):
-        overflow = not np.all(np.isfinite(signed_areas(f, uv)))
+        overflow = not np.all(np.isfinite(signed_areas(uv, f)))
     if overflow:
         raise FlattenError(
             f"{name}: the {method} grower diverged (flat coordinates beyond double precision); "
@@ -288,9 +288,9 @@ def _relaxed(v, f, conn, greedy, z, pins, lengths, progress, **options):
     on the input's numbering, nor on the part's placement in space.
     """
     start, label, barrier = greedy, "greedy", 0.0
-    if not overlap_verdict(f, start, conn.loops).one_to_one:
+    if not overlap_verdict(start, f, conn.loops).one_to_one:
         start, label = lscm(v, f, conn, local=z), "lscm"
-        if not overlap_verdict(f, start, conn.loops).one_to_one:
+        if not overlap_verdict(start, f, conn.loops).one_to_one:
             start, label = tutte_embedding(v, f, conn), "tutte"
         # These layouts have no true scale of their own: start from the best one.
         start = start * best_scale(v, conn.edges, start)

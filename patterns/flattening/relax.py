@@ -91,7 +91,7 @@ class Relaxation:
     energy: str = "arap"
 
 
-def flip_free_steps(faces: np.ndarray, uv: np.ndarray, step: np.ndarray, *, horizon: float = np.inf,
+def flip_free_steps(uv: np.ndarray, faces: np.ndarray, step: np.ndarray, *, horizon: float = np.inf,
                     corners: tuple | None = None) -> np.ndarray:
     """Largest ``t`` per triangle such that ``uv + s * step`` keeps it positive for all ``s < t``.
 
@@ -100,8 +100,8 @@ def flip_free_steps(faces: np.ndarray, uv: np.ndarray, step: np.ndarray, *, hori
 
     Parameters
     ----------
-    faces : (m, 3) int64
     uv, step : (n, 2) float64
+    faces : (m, 3) int64
     horizon : float
         Only roots below this matter: triangles whose area stays positive up to
         ``horizon`` get ``inf`` without solving (much faster when most are safe).
@@ -544,7 +544,7 @@ class _Minimiser:
             memory.clear()
             direction[self.free] = -hgrad
             slope = dot(grad, self.restrict(direction))
-        step = min(1.0, 0.9 * float(flip_free_steps(self.faces, uv, direction, horizon=1.0 / 0.9,
+        step = min(1.0, 0.9 * float(flip_free_steps(uv, self.faces, direction, horizon=1.0 / 0.9,
                                                      corners=self.objective.fr.corners).min()))
         # Steps below round-off of the layout's size make no progress.
         smallest = 1e-13 * self.size / max(float(np.abs(direction).max()), 1e-300)
@@ -645,11 +645,11 @@ def _safe_move(faces: np.ndarray, loops, uv: np.ndarray, target: np.ndarray, *, 
     step = target - uv
     n = len(uv)
     alpha = np.ones(n)
-    per_face = np.minimum(0.9 * flip_free_steps(faces, uv, step, horizon=1.0 / 0.9), 1.0)
+    per_face = np.minimum(0.9 * flip_free_steps(uv, faces, step, horizon=1.0 / 0.9), 1.0)
     np.minimum.at(alpha, faces.ravel(), np.repeat(per_face, 3))
     for attempt in range(2 * tries):
         cand = uv + alpha[:, None] * step
-        bad = ~(signed_areas(faces, cand) > 0)
+        bad = ~(signed_areas(cand, faces) > 0)
         crossing = None if bad.any() else _boundary_crossings(cand, loops)
         if not bad.any() and crossing is None:
             return cand

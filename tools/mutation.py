@@ -1,0 +1,102 @@
+"""Mutation testing of the numerical and export modules with mutmut: the score, and every survivor.
+
+Usage (from the repository root; 20-60 minutes on two cores)::
+
+    python tools/mutation.py                      # the five modules of docs/testing.md
+    python tools/mutation.py patterns/measure.py  # one module
+
+mutmut rewrites each function of a module into many small variants ("mutants":
+a ``<`` made ``<=``, a constant changed, an argument dropped, ...) and runs the
+tests that reach that function against each; a mutant no test notices
+"survives".  The score is ``killed / (killed + survived)``, with a timeout
+counted as killed (the tests noticed: they hung).
+
+mutmut imports the package from its own copy (``mutants/``), so it cannot run
+where ``patterns`` is installed in editable mode: this script makes a separate
+virtual environment (``.mutation-venv``, once: the dependencies from
+pyproject.toml, mutmut, pytest) and runs in a copy of the repository (the
+samples and tests go with it), so the working tree is never touched.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import tomllib
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+VENV = REPO / ".mutation-venv"
+
+MODULES = {  # the module mutated and the tests that answer for it
+    "patterns/measure.py": ["tests/test_measure.py", "tests/test_check.py"],
+    "patterns/audit.py": ["tests/test_check.py", "tests/test_seams.py"],
+    "patterns/export/dxf.py": ["tests/test_dxf_pattern.py", "tests/test_export.py"],
+    "patterns/flattening/develop.py": ["tests/test_sheet_metal.py", "tests/test_model.py"],
+    "patterns/nesting.py": ["tests/test_garments.py"],
+}
+
+
+def _venv() -> Path:
+    python = VENV / "bin" / "python"
+    if not python.exists():
+        subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
+        meta = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+        deps = meta["dependencies"] + meta["optional-dependencies"]["test"] + ["mutmut>=3.3"]
+        subprocess.run([str(python), "-m", "pip", "install", "-q", *deps], check=True)
+    return python
+
+
+def run(module: str, tests: list, python: Path) -> dict:
+    """Run mutmut on one module in a copy of the repository: ``{"killed", "survived", "timeout", "survivors"}``."""
+    with tempfile.TemporaryDirectory(prefix="patterns-mutation-") as tmp:
+        work = Path(tmp) / "repo"
+        shutil.copytree(REPO, work, ignore=shutil.ignore_patterns(".git", ".venv", ".mutation-venv", "mutants",
+                                                                   "__pycache__", "*.egg-info"))
+        config = (f'\n[tool.mutmut]\nsource_paths = ["patterns"]\nonly_mutate = ["{module}"]\n'
+                  f"pytest_add_cli_args_test_selection = {tests!r}\nmutate_only_covered_lines = true\n"
+                  'also_copy = ["samples/"]\n').replace("'", '"')
+        with open(work / "pyproject.toml", "a") as fh:
+            fh.write(config)
+        mutmut = [str(python), "-m", "mutmut"]
+        subprocess.run([*mutmut, "run"], cwd=work, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        listing = subprocess.run([*mutmut, "results", "--all", "true"], cwd=work, capture_output=True,
+                                 text=True).stdout
+    status = re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M)
+    out = {"killed": 0, "survived": 0, "timeout": 0, "other": 0, "survivors": []}
+    for name, state in status:
+        key = {"killed": "killed", "survived": "survived", "timeout": "timeout"}.get(state.strip(), "other")
+        out[key] += 1
+        if key == "survived":
+            out["survivors"].append(name)
+    return out
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("modules", nargs="*", default=list(MODULES), help="modules (default: the five)")
+    args = parser.parse_args(argv)
+    python = _venv()
+    total_k = total_s = 0
+    rows = []
+    for module in args.modules:
+        r = run(module, MODULES.get(module, ["tests/"]), python)
+        killed = r["killed"] + r["timeout"]
+        total_k, total_s = total_k + killed, total_s + r["survived"]
+        score = killed / max(killed + r["survived"], 1)
+        rows.append(f"| `{module}` | {killed + r['survived']} | {killed} | {r['survived']} | {score:.1%} |")
+        for name in r["survivors"]:
+            print(f"survived: {name}", file=sys.stderr)
+    print("| module | mutants | killed (timeouts included) | survived | score |")
+    print("|---|---|---|---|---|")
+    print("\n".join(rows))
+    print(f"| all | {total_k + total_s} | {total_k} | {total_s} | {total_k / max(total_k + total_s, 1):.1%} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
