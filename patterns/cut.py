@@ -23,7 +23,15 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from .errors import MeshTopologyError
-from .mesh import _readonly, as_mesh_arrays, check_boundary_vertices, corner_angles, edge_lengths, edge_tables, trace_loops
+from .mesh import (
+    _readonly,
+    as_mesh_arrays,
+    check_boundary_vertices,
+    corner_angles,
+    edge_lengths,
+    edge_tables,
+    trace_loops,
+)
 
 __all__ = ["Cut", "cut_along", "cut_to_disk", "pieces"]
 
