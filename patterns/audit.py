@@ -15,10 +15,10 @@ import shapely
 from .errors import InputError
 from .files import atomic_output
 from .measure import edge_strain, folded_faces, strain_stats
-from .mesh import _readonly
+from .mesh import _readonly, polyline_length
 from .options import Options, option
 from .pattern import Pattern
-from .predicates import Overlap, boundary_crossings, crossing_segments, overlap_verdict
+from .predicates import Overlap, boundary_crossings, crossing_segments, flat_polygon, overlap_verdict
 
 __all__ = ["REPORT_SCHEMA", "CheckOptions", "Code", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
            "boundary_crossings", "check", "crossing_segments", "overlap_verdict"]
@@ -323,7 +323,7 @@ def _panel_report(flat, max_strain):
     none = np.zeros(0, dtype=np.int64)
     if flat.darts:
         tips = np.array([uv[d[-1]] for d in flat.darts])
-        length = sum(float(np.linalg.norm(np.diff(vertices[d], axis=0), axis=1).sum()) for d in flat.darts)
+        length = sum(polyline_length(vertices[d]) for d in flat.darts)
         findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), _readonly(tips), none,
                                 None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
                                       f"the limit ({length:.1f} mm of cuts; points: their tips)"))
@@ -397,7 +397,7 @@ def _panel_overlaps(flat) -> list:
         c = uv[loops[0]].mean(axis=0)
         out.append(Finding(Code.INSIDE_OUT, Severity.ERROR, (name,), c[None, :], none, None,
                            f"panel {name}: the flat outline runs clockwise (the panel is turned inside out)"))
-    outer = shapely.Polygon(uv[loops[0]])
+    outer = flat_polygon(uv, loops, holes=False)
     for k in range(1, len(loops)):
         inside = shapely.contains_xy(outer, uv[loops[k], 0], uv[loops[k], 1])
         if not inside.any():
@@ -414,7 +414,7 @@ def _overlaps_between(pattern) -> list:
     polys = []
     for flat in pattern.panels:
         uv = flat.uv
-        polys.append(shapely.make_valid(shapely.Polygon(uv[flat.loops[0]], [uv[lp] for lp in flat.loops[1:]])))
+        polys.append(shapely.make_valid(flat_polygon(uv, flat.loops)))
     polys = np.array(polys, dtype=object)
     i, j = shapely.STRtree(polys).query(polys, predicate="intersects")
     keep = i < j

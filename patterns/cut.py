@@ -28,7 +28,7 @@ from .mesh import (
     as_mesh_arrays,
     check_boundary_vertices,
     corner_angles,
-    edge_lengths,
+    edge_graph,
     edge_tables,
     trace_loops,
 )
@@ -158,10 +158,7 @@ def cut_to_disk(vertices: np.ndarray, faces: np.ndarray, *, name: str = "mesh") 
 
 
 def _edge_graph(vertices, t, keep):
-    e = t.edges[keep]
-    w = edge_lengths(vertices, e)
-    n = len(vertices)
-    return sp.coo_matrix((np.r_[w, w], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), shape=(n, n)).tocsr()
+    return edge_graph(vertices, t.edges[keep])
 
 
 def _backtrack(pred: np.ndarray, end: int) -> np.ndarray:

@@ -514,3 +514,34 @@ def corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
         cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
         angle[:, k] = np.arccos(np.clip(cos, -1.0, 1.0))
     return angle
+
+
+def polyline_arc(points: np.ndarray) -> np.ndarray:
+    """Cumulative length ``(k,) float64`` along a polyline ``(k, d)``: 0 at its first point, its length at the last."""
+    points = np.asarray(points, dtype=np.float64)
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+
+
+def polyline_length(points: np.ndarray) -> float:
+    """Length of a polyline ``(k, d)`` through its points, in their unit (0 for one point)."""
+    return float(np.linalg.norm(np.diff(np.asarray(points, dtype=np.float64), axis=0), axis=1).sum())
+
+
+def loop_length(points: np.ndarray, loop: np.ndarray) -> float:
+    """Length of the closed loop through ``points[loop]`` (back to the first), in their unit."""
+    return polyline_length(np.asarray(points)[np.r_[loop, loop[:1]]])
+
+
+def longest_first(points: np.ndarray, loops) -> tuple:
+    """Loops ordered by their length through ``points`` (3D for a panel), longest first (the outline)."""
+    return tuple(sorted(loops, key=lambda loop: -loop_length(points, loop)))
+
+
+def edge_graph(points: np.ndarray, edges: np.ndarray) -> sp.csr_matrix:
+    """The undirected graph ``(n, n)`` of ``edges`` ``(e, 2)`` weighted by their lengths through ``points``
+    (for shortest paths along a mesh: :func:`scipy.sparse.csgraph.dijkstra`)."""
+    edges = np.asarray(edges, dtype=np.int64)
+    w = edge_lengths(points, edges)
+    n = len(points)
+    return sp.coo_matrix((np.r_[w, w], (np.r_[edges[:, 0], edges[:, 1]], np.r_[edges[:, 1], edges[:, 0]])),
+                         shape=(n, n)).tocsr()

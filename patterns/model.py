@@ -12,9 +12,9 @@ from enum import Enum
 
 import numpy as np
 
-from .mesh import face_areas
+from .mesh import face_areas, longest_first, polyline_length, validate_mesh
 
-__all__ = ["Bookkeeping", "Model", "Panel", "Seam", "Surface", "SurfaceKind"]
+__all__ = ["Bookkeeping", "panel_from_mesh", "Model", "Panel", "Seam", "Surface", "SurfaceKind"]
 
 
 def _own(array, dtype=None) -> np.ndarray:
@@ -154,7 +154,7 @@ class Seam:
     @property
     def polyline_length(self) -> float:
         """Length of the polyline through :attr:`points`, mm (below :attr:`length` on a curve)."""
-        return float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
+        return polyline_length(self.points)
 
     @property
     def closes_panel(self) -> bool:
@@ -220,3 +220,13 @@ class Model:
     def __repr__(self) -> str:
         return (f"Model({self.name!r}, {len(self.panels)} panels, {len(self.seams)} seams, "
                 f"max_edge={self.max_edge:.4g} mm)")
+
+
+def panel_from_mesh(label: str, vertices, faces, *, name: str, cad_faces: tuple = (), surface=None,
+                    param=None) -> Panel:
+    """A :class:`Panel` from a disk-like mesh: validated (``name`` in messages), its loops longest first.
+
+    The one way loading builds a panel, from a mesh file's piece or from CAD faces.
+    """
+    v, f, conn = validate_mesh(vertices, faces, name=name)
+    return Panel(label, v, f, longest_first(v, conn.loops), tuple(cad_faces), surface=surface, param=param)

@@ -15,6 +15,7 @@ import numpy as np
 
 from .errors import InputError, LayoutError
 from .options import check_number
+from .predicates import flat_polygon
 
 __all__ = ["Layout", "LayoutError", "Placeable", "layout"]
 
@@ -118,7 +119,7 @@ def layout(pattern, *, width: float, gap: float = 10.0, margin: float = 0.0, all
     shapes, outlines, base = [], [], []
     for flat in pattern.panels:
         uv = flat.flattening.uv
-        outline = shapely.Polygon(uv[flat.loops[0]])
+        outline = flat_polygon(uv, flat.loops, holes=False)
         turn = 0.0
         if not respect_grain:
             # Square the panel up first: its minimum rotated rectangle along the axes.

@@ -16,7 +16,10 @@ import shapely
 
 from .errors import InputError
 from .measure import TriangleStrain, flat_direction, no_strain, triangle_strains
+from .mesh import polyline_arc
 from .model import Model, Panel, Seam, SurfaceKind
+from .options import check_number
+from .predicates import flat_polygon
 
 if TYPE_CHECKING:  # the engine imports this module; the annotation only names its result type
     from .flattening.engine import Flattening
@@ -84,11 +87,9 @@ class FlatPanel:
         surface = self.panel.surface
         if self.flattening.method != "exact" or surface is None or surface.kind is SurfaceKind.PLANE:
             return []
-        if not (isinstance(spacing, (int, float)) and spacing > 0):
-
-            raise InputError(f"panel {self.name}: ruling spacing must be a positive number of mm, got {spacing!r}")
+        spacing = check_number(spacing, "ruling spacing (mm)", low=0, low_open=True, name=f"panel {self.name}")
         uv = self.flattening.uv
-        polygon = shapely.Polygon(uv[self.loops[0]], [uv[lp] for lp in self.loops[1:]])
+        polygon = flat_polygon(uv, self.loops)
         size = float(np.ptp(uv, axis=0).max()) * 4 + 1.0
         lines = []
         if surface.kind is SurfaceKind.CYLINDER:
@@ -141,7 +142,7 @@ class FlatPanel:
         facets on either side of it."""
 
         d3 = surface.directrix
-        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(d3, axis=0), axis=1))])
+        arc = polyline_arc(d3)
         n = max(int(round(arc[-1] / spacing)), 1)
         marks = np.linspace(0.0, arc[-1], n + 1)
         pts = np.column_stack([np.interp(marks, arc, d3[:, k]) for k in range(3)])

@@ -23,7 +23,7 @@ import shapely
 
 from .measure import folded_faces
 
-__all__ = ["Overlap", "boundary_crossings", "crossing_segments", "overlap_verdict"]
+__all__ = ["flat_polygon", "Overlap", "boundary_crossings", "crossing_segments", "overlap_verdict"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,3 +161,18 @@ def boundary_crossings(uv: np.ndarray, loops) -> list[tuple[int, int, np.ndarray
         if len(pts):
             out.setdefault(key, []).append(pts.mean(axis=0))
     return [(a, b, np.array(p)) for (a, b), p in sorted(out.items())]
+
+
+def flat_polygon(uv: np.ndarray, loops, *, holes: bool = True):
+    """The shapely polygon of a flat panel: ``uv[loops[0]]`` the outline, the other loops its holes.
+
+    Parameters
+    ----------
+    uv : (n, 2) float64
+    loops : sequence of (k,) int64
+        Outline first (as :attr:`patterns.Panel.loops` orders them).
+    holes : bool
+        False: the outline alone (what nesting places).
+    """
+    uv = np.asarray(uv, dtype=np.float64)
+    return shapely.Polygon(uv[loops[0]], [uv[loop] for loop in loops[1:]] if holes else None)

@@ -26,8 +26,8 @@ import numpy as np
 
 from .cut import cut_to_disk, pieces
 from .errors import CadError, InputError
-from .mesh import as_mesh_arrays, drop_unused, unique_ints, validate_mesh
-from .model import Bookkeeping, Model, Panel, Seam
+from .mesh import as_mesh_arrays, drop_unused, polyline_length, unique_ints
+from .model import Bookkeeping, Model, Seam, panel_from_mesh
 from .options import option
 from .tessellate import MeshingOptions, mesh_shape
 from .units import UNIT_NAMES, Unit
@@ -331,13 +331,11 @@ def mesh_model(vertices, faces, *, name: str = "mesh"):
         pname = name if len(groups) == 1 else f"{name}: {label}"
         pv, pf, _ = drop_unused(v, f[group])
         cut = cut_to_disk(pv, pf, name=pname)
-        cv, cf, conn = validate_mesh(cut.vertices, cut.faces, name=pname)
-        loops = sorted(conn.loops, key=lambda lp: -np.linalg.norm(cv[np.roll(lp, -1)] - cv[lp], axis=1).sum())
-        panels.append(Panel(label, cv, cf, tuple(loops)))
+        panels.append(panel_from_mesh(label, cut.vertices, cut.faces, name=pname))
         for path, (left, right) in zip(cut.paths, cut.sides):
             points = pv[path]
             seams.append(Seam(id=len(seams), panels=(i, i), points=points, vertices=(left, right),
-                              length=float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())))
+                              length=polyline_length(points)))
     edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     longest = float(np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1).max())
     return Model(name=name, panels=tuple(panels), seams=tuple(seams), max_edge=longest,

@@ -20,6 +20,7 @@ from shapely.geometry.polygon import orient
 from ..errors import InputError
 from ..files import atomic_output
 from ..measure import strain_stats, triangle_strains
+from ..mesh import polyline_arc
 from ..options import Options, check_number, is_number, option
 from ..units import UNIT_NAMES, Unit
 from .arcs import fit_arcs
@@ -369,7 +370,7 @@ def notch_positions(flat_seam, side: int, uv: np.ndarray, spacing: float | None)
     """
     seam = flat_seam.seam
     pts = uv[seam.vertices[side]]
-    c3 = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(seam.points, axis=0), axis=1))])
+    c3 = polyline_arc(seam.points)
     total = c3[-1]
     if spacing:
         marks = np.arange(0.0, total, spacing)

@@ -8,12 +8,11 @@ point along mesh edges, kept only when they lower the strain.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ..cut import cut_along
 from ..measure import strain_rms, triangle_strains
-from ..mesh import unique_edges, unique_ints
+from ..mesh import edge_graph, unique_edges, unique_ints
 from .engine import Flattening, flatten_mesh
 from .seams import seam_edges
 
@@ -87,10 +86,7 @@ def strained_depths(result: Flattening, limit: float):
     if not len(above):
         return None
     n = len(v)
-    edges = unique_edges(f)
-    weight = np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1)
-    graph = sp.coo_matrix((np.r_[weight, weight], (np.r_[edges[:, 0], edges[:, 1]],
-                                                    np.r_[edges[:, 1], edges[:, 0]])), shape=(n, n)).tocsr()
+    graph = edge_graph(v, unique_edges(f))
     boundary = unique_ints(np.concatenate(result.loops))
     dist, pred, _ = csgraph.dijkstra(graph, indices=boundary, min_only=True, return_predecessors=True)
     strained = np.zeros(n, dtype=bool)

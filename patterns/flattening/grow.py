@@ -57,7 +57,7 @@ import numpy as np
 from scipy.sparse import coo_matrix, csgraph
 
 from ..errors import FlattenError
-from ..mesh import Connectivity, edge_lengths, unique_ints
+from ..mesh import Connectivity, edge_graph, unique_ints
 
 __all__ = [
     "grow_fronts",
@@ -181,10 +181,7 @@ def seed_face(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity) -> in
         distance to the nearest boundary vertex (the lowest index among
         faces within round-off of it).
     """
-    e = conn.edges
-    length = edge_lengths(vertices, e)
-    n = conn.n_vertices
-    graph = coo_matrix((length, (e[:, 0], e[:, 1])), shape=(n, n)).tocsr()
+    graph = edge_graph(vertices, conn.edges)
     sources = unique_ints(np.concatenate(conn.loops))
     dist = csgraph.dijkstra(graph, directed=False, indices=sources, min_only=True)
     depth = dist[faces].sum(axis=1)

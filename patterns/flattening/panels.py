@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..mesh import unique_edges
+from ..mesh import polyline_length, unique_edges
 from ..model import Model
 from ..pattern import FlatPanel, FlatSeam, Pattern
 from .darts import cut_darts
@@ -143,6 +143,6 @@ def _side_targets(model, panel: int, result: Flattening, eased: dict, mode) -> d
             if p == panel:
                 pts = result.vertices[np.asarray(seam.vertices[side])]
                 # 3D: the copies of a point coincide, so the polyline is measured as it is.
-                length = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
+                length = polyline_length(pts)
                 out[(seam.id, side)] = length * eased.get((seam.id, side), 1.0)
     return out

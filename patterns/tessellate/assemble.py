@@ -7,8 +7,8 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ..cut import cut_to_disk
-from ..mesh import unique_ints, validate_mesh
-from ..model import Bookkeeping, Model, Panel, Seam
+from ..mesh import polyline_length, unique_ints
+from ..model import Bookkeeping, Model, Seam, panel_from_mesh
 from .edges import EdgeDivision
 from .recognise import surface_of
 from .sizes import Sizes
@@ -52,7 +52,7 @@ def assemble(topology: Topology, sizes: Sizes, division: EdgeDivision, meshes: t
     for p, (_, (left, right)) in cuts:
         pts = panels[p].vertices[left]
         seams.append(Seam(id=len(seams), panels=(p, p), points=pts, vertices=(left, right),
-                          length=float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())))
+                          length=polyline_length(pts)))
     return Model(name=topology.name, panels=tuple(panels), seams=tuple(seams), max_edge=sizes.h,
                  bookkeeping=Bookkeeping(cuts=len(cuts)))
 
@@ -95,13 +95,12 @@ def _panel(name, label, members, meshes, offsets, root, coords, surfaces, *, clo
         cut = cut_to_disk(vertices, faces, name=pname)
         vertices, faces = cut.vertices, cut.faces
         made = list(zip(cut.paths, cut.sides))
-    v, f, conn = validate_mesh(vertices, faces, name=pname)
-    loops = sorted(conn.loops, key=lambda lp: -np.linalg.norm(v[np.roll(lp, -1)] - v[lp], axis=1).sum())
     surface = param = None
     if len(members) == 1 and surfaces[members[0]] is not None:
         k = members[0]
         surface, param = surfaces[k], meshes[k].param[fv[first[order]] - offsets[k]]
-    return Panel(label, v, f, tuple(loops), tuple(members), surface=surface, param=param), local, made
+    panel = panel_from_mesh(label, vertices, faces, name=pname, cad_faces=members, surface=surface, param=param)
+    return panel, local, made
 
 
 def _edge_seams(topology, division, occ_of_edge, panel_of_face, self_merged, local_of) -> list:
