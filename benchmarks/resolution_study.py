@@ -9,7 +9,9 @@ the edge-strain RMS and max and the folded-triangle count on
 * a 60-degree spherical cap (radius 100 mm, polar half-angle 30 degrees),
 
 at 1k, 10k, 100k (and, with ``--million``, 1M) faces.  The heap order is a
-Python loop and is skipped above 100k faces.
+Python loop and is skipped above 100k faces.  Time is printed as a ratio to a
+peer timed side by side on the same mesh in the same run: libigl's LSCM
+(``bench_flatten.igl_lscm``, a linear solve, the usual one-shot flattening).
 
     python benchmarks/resolution_study.py [--million]
 """
@@ -17,9 +19,14 @@ Python loop and is skipped above 100k faces.
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_flatten as bench  # libigl's LSCM, as the benchmark runs it
 
 import patterns
 from patterns import surfaces
@@ -42,7 +49,7 @@ SHAPES = {
 def study(sizes: list[int]) -> list[str]:
     """Run every combination; return markdown table rows."""
     rows = [
-        "| surface | faces | step | growth | seconds | edge strain RMS | max | folds |",
+        "| surface | faces | step | growth | time / libigl LSCM | edge strain RMS | max | folds |",
         "|---|---:|---|---|---:|---:|---:|---:|",
     ]
     for shape, make in SHAPES.items():
@@ -52,6 +59,7 @@ def study(sizes: list[int]) -> list[str]:
             weights = 0.5 * np.abs(np.imag(np.conj(z[:, 1]) * z[:, 2]))
             seed = grow.seed_face(v, f, conn)
             rotations = grow.transported_rotations(z, f, conn, seed)
+            peer, _ = bench.best_of(lambda: bench.igl_lscm(v, f), 1)
             for step_name, step in STEPS.items():
                 for growth_name, growth in GROWTHS.items():
                     if growth_name == "heap" and len(f) > 150_000:
@@ -62,7 +70,7 @@ def study(sizes: list[int]) -> list[str]:
                     seconds = time.perf_counter() - start
                     d = patterns.distortion(v, f, np.column_stack([w.real, w.imag]))
                     rows.append(
-                        f"| {shape} | {len(f)} | {step_name} | {growth_name} | {seconds:.2f} | "
+                        f"| {shape} | {len(f)} | {step_name} | {growth_name} | {seconds / peer:.2f} | "
                         f"{d.edge_strain_rms:.3g} | {d.edge_strain_max:.3g} | {d.n_folded} |"
                     )
                     print(rows[-1], flush=True)

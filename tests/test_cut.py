@@ -1,0 +1,82 @@
+"""patterns.cut: cutting meshes open, on a closed sphere, a tube, a washer and along a path,
+checked by Euler's formula, boundary counts and the lengths of the cuts."""
+
+import numpy as np
+import pytest
+import trimesh
+
+import patterns
+from patterns import surfaces
+from patterns.cut import cut_along, pieces
+from patterns.errors import MeshTopologyError
+from patterns.mesh import validate_mesh
+
+
+def _euler(v, f):
+    e = np.unique(np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1), axis=0)
+    return len(v) - len(e) + len(f)
+
+
+def test_pieces_are_the_connected_parts():
+    f = np.array([[0, 1, 2], [3, 4, 5], [2, 1, 6]])
+    groups = pieces(f, 7)
+    assert sorted(sorted(g.tolist()) for g in groups) == [[0, 2], [1]]
+
+
+def test_a_closed_sphere_is_slit_into_a_disk():
+    ball = trimesh.creation.icosphere(subdivisions=2, radius=30.0)
+    cut = patterns.cut_to_disk(ball.vertices, ball.faces)
+    assert _euler(ball.vertices, ball.faces) == 2
+    (path,) = cut.paths
+    v, f, conn = validate_mesh(cut.vertices, cut.faces)  # a disk now: one boundary loop
+    assert len(conn.loops) == 1 and _euler(v, f) == 1
+    assert len(cut.vertices) == len(ball.vertices) + len(path) - 2  # the slit's inner vertices doubled
+    left, right = cut.sides[0]
+    np.testing.assert_array_equal(cut.source[left], cut.source[right])
+
+
+def test_a_tube_is_cut_between_its_rims_and_a_washer_is_not():
+    v, f = surfaces.cylinder_patch(radius=20.0, height=50.0, angle=360.0, n_around=40, n_along=10)
+    _, index, inverse = np.unique(np.round(v, 9), axis=0, return_index=True, return_inverse=True)
+    v, f = v[index], inverse.ravel()[f]
+    cut = patterns.cut_to_disk(v, f)
+    (path,) = cut.paths
+    length = np.linalg.norm(np.diff(v[path], axis=0), axis=1).sum()
+    assert length == pytest.approx(50.0, rel=1e-9)  # straight down a ruling: the shortest way
+    assert len(validate_mesh(cut.vertices, cut.faces)[2].loops) == 1
+    # a washer (a flat annulus): its hole turns by -2 pi, a real hole, kept
+    t = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    ring = np.concatenate([np.column_stack([10 * np.cos(t), 10 * np.sin(t), 0 * t]),
+                           np.column_stack([20 * np.cos(t), 20 * np.sin(t), 0 * t])])
+    i = np.arange(24)
+    j = (i + 1) % 24
+    wf = np.concatenate([np.column_stack([i, j, 24 + j]), np.column_stack([i, 24 + j, 24 + i])])
+    washer = patterns.cut_to_disk(ring, wf)
+    assert washer.paths == () and len(validate_mesh(washer.vertices, washer.faces)[2].loops) == 2
+
+
+def test_a_torus_cannot_be_opened_by_one_cut():
+    torus = trimesh.creation.torus(major_radius=30.0, minor_radius=8.0)
+    with pytest.raises(MeshTopologyError, match="handles"):
+        patterns.cut_to_disk(torus.vertices, torus.faces)
+
+
+def test_a_dart_from_the_outline_stops_inside():
+    v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=600)
+    _, _, conn = validate_mesh(v, f)
+    start = int(conn.loops[0][0])
+    inner = int(np.argmin(np.linalg.norm(v[:, :2], axis=1)))  # the pole
+    import scipy.sparse.csgraph as csgraph
+
+    from patterns.mesh import edge_graph
+
+    _, pred = csgraph.dijkstra(edge_graph(v, conn.edges), indices=start, return_predecessors=True)
+    path = [inner]
+    while path[-1] != start:
+        path.append(int(pred[path[-1]]))
+    path = np.array(path[::-1])
+    cut = cut_along(v, f, path)
+    left, right = cut.sides[0]
+    assert left[0] != right[0] and left[-1] == right[-1]  # open at the outline, closed at the tip
+    assert len(cut.vertices) == len(v) + len(path) - 1
+    assert len(validate_mesh(cut.vertices, cut.faces)[2].loops) == 1

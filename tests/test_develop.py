@@ -1,0 +1,76 @@
+"""patterns.flattening.develop: exact developments of planes, cylinders and cones against their
+analytic formulas, and the neutral surface of a sheet."""
+
+import numpy as np
+import pytest
+
+from patterns.errors import InputError
+from patterns.flattening.develop import develop, neutral_offset, offset_points
+from patterns.model import Surface, SurfaceKind
+
+X, Y, Z = np.eye(3)
+
+
+def _surface(kind, **extra):
+    return Surface(kind=kind, origin=np.zeros(3), x_dir=X, y_dir=Y, axis=Z, **extra)
+
+
+def test_a_plane_develops_to_its_own_frame():
+    plane = Surface(kind=SurfaceKind.PLANE, origin=np.array([1.0, 2.0, 3.0]), x_dir=Y, y_dir=-X, axis=Z)
+    pts = np.array([[1.0, 2.0, 3.0], [1.0, 7.0, 3.0], [-3.0, 2.0, 3.0]])
+    np.testing.assert_allclose(develop(plane, pts), [[0, 0], [5, 0], [0, 4]], atol=1e-12)
+
+
+def test_a_cylinder_unrolls_to_radius_times_angle():
+    r = 40.0
+    u = np.linspace(0.1, 4.0, 9)
+    v = np.linspace(-5.0, 30.0, 9)
+    pts = np.column_stack([r * np.cos(u), r * np.sin(u), v])
+    uv = develop(_surface(SurfaceKind.CYLINDER, radius=r), pts)
+    np.testing.assert_allclose(uv[:, 0] - uv[0, 0], r * (u - u[0]), rtol=1e-12)
+    np.testing.assert_allclose(uv[:, 1], v, atol=1e-12)
+
+
+def test_a_cone_unrolls_to_an_annular_sector():
+    """Cone of half-angle a with reference radius R at height 0: a point at angle u and height h
+    lies at distance s = (R + h tan a) / sin a from the apex, at angle u sin a in the sector."""
+    a, big_r = np.radians(30.0), 50.0
+    u = np.linspace(0.0, 5.0, 7)
+    h = np.linspace(0.0, 40.0, 7)
+    rr = big_r + h * np.tan(a)
+    pts = np.column_stack([rr * np.cos(u), rr * np.sin(u), h])
+    uv = develop(_surface(SurfaceKind.CONE, radius=big_r, semi_angle=a), pts)
+    s = rr / np.sin(a)
+    np.testing.assert_allclose(np.hypot(uv[:, 0], uv[:, 1]), s, rtol=1e-12)
+    angles = np.unwrap(np.arctan2(uv[:, 1], uv[:, 0]))
+    np.testing.assert_allclose(angles - angles[0], (u - u[0]) * np.sin(a), atol=1e-12)
+
+
+def test_the_seam_side_is_chosen_by_the_parameter():
+    """The same 3D point on both sides of a cylinder's seam line: the parameter says which end."""
+    r = 10.0
+    pts = np.array([[r, 0.0, 0.0], [r, 0.0, 0.0]])
+    uv = develop(_surface(SurfaceKind.CYLINDER, radius=r), pts, param=np.array([[0.0, 0.0], [2 * np.pi, 0.0]]))
+    assert uv[1, 0] - uv[0, 0] == pytest.approx(2 * np.pi * r, rel=1e-12)
+
+
+@pytest.mark.parametrize(("reference", "expected"), [("inside", 0.88), ("outside", -1.12), ("mid", -0.12)])
+def test_the_neutral_surface_lies_k_t_from_the_inside_skin(reference, expected):
+    """t = 2 mm, K = 0.44: the neutral surface is 0.88 mm from the inside skin."""
+    assert neutral_offset(2.0, 0.44, reference) == pytest.approx(expected, abs=1e-12)
+
+
+@pytest.mark.parametrize("kwargs", [{"thickness": -1.0}, {"k_factor": 1.5}, {"reference": "middle"}])
+def test_bad_sheet_options_are_refused(kwargs):
+    args = {"thickness": 2.0, "k_factor": 0.5, "reference": "mid", **kwargs}
+    with pytest.raises(InputError):
+        neutral_offset(args["thickness"], args["k_factor"], args["reference"])
+
+
+def test_offsetting_a_cylinder_moves_points_radially():
+    r = 40.0
+    u = np.linspace(0.0, 3.0, 5)
+    pts = np.column_stack([r * np.cos(u), r * np.sin(u), np.arange(5.0)])
+    moved = offset_points(_surface(SurfaceKind.CYLINDER, radius=r), pts, 1.5)
+    np.testing.assert_allclose(np.hypot(moved[:, 0], moved[:, 1]), r + 1.5, rtol=1e-12)
+    np.testing.assert_allclose(moved[:, 2], pts[:, 2], atol=1e-12)
