@@ -52,6 +52,7 @@ def study(sizes: list[int]) -> list[str]:
         "| surface | faces | step | growth | time / libigl LSCM | edge strain RMS | max | folds |",
         "|---|---:|---|---|---:|---:|---:|---:|",
     ]
+    print("\n".join(rows), flush=True)
     for shape, make in SHAPES.items():
         for n in sizes:
             v, f, conn = validate_mesh(*make(n))

@@ -1,7 +1,9 @@
 """The flat pattern: every panel laid flat at true scale, with its seams.
 
-:func:`patterns.flatten` returns a :class:`Pattern`.  A :class:`FlatPanel` keeps
-the 3D panel it came from; vertex ``i`` of the panel is at ``uv[i]`` in the
+:func:`patterns.flatten_mesh` returns a :class:`Flattening` (one mesh laid flat:
+positions, overlap verdict, how the engine got there); :func:`patterns.flatten`
+returns a :class:`Pattern`.  A :class:`FlatPanel` keeps its Flattening and the
+3D panel it came from; vertex ``i`` of the panel is at ``uv[i]`` in the
 plane (the 3D <-> 2D map is the vertex index).  Millimetres throughout.
 """
 
@@ -9,22 +11,85 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
 
 from .errors import InputError
-from .measure import TriangleStrain, flat_direction, no_strain, triangle_strains
+from .measure import Distortion, TriangleStrain, distortion, flat_direction, no_strain, triangle_strains
 from .mesh import polyline_arc
 from .model import Model, Panel, Seam, SurfaceKind
 from .options import check_number
-from .predicates import flat_polygon
+from .predicates import Overlap, flat_polygon
 
-if TYPE_CHECKING:  # the engine imports this module; the annotation only names its result type
-    from .flattening.engine import Flattening
+__all__ = ["FlatPanel", "FlatSeam", "Flattening", "Pattern"]
 
-__all__ = ["FlatPanel", "FlatSeam", "Pattern"]
+
+@dataclass(frozen=True, eq=False)
+class Flattening:
+    """The result of :func:`flatten_mesh`.
+
+    Attributes
+    ----------
+    uv : (n, 2) float64
+        Flat position of every input vertex, in the input's vertex order and
+        unit, at true scale (read-only).
+    vertices : (n, 3) float64
+        The validated input vertices (read-only).
+    faces : (m, 3) int64
+        The validated input faces (read-only).
+    loops : tuple of (k,) int64
+        Boundary loops (vertex indices, surface to their left; longest first).
+    method : str
+    seed_face : int
+        The triangle the greedy grower laid down first, without distortion.
+    overlap : Overlap
+        The overlap verdict: folded triangles, loop tests, ``one_to_one``.
+    start : str
+        ``"relaxed"`` only: the layout the relaxation started from --
+        ``"greedy"`` (the isometric grower's, when it is one-to-one), else
+        ``"lscm"`` (when that is one-to-one), else ``"tutte"``; "" otherwise.
+    iterations : int
+        ``"relaxed"`` only: relaxation iterations run (0 otherwise).
+    converged : bool
+        ``"relaxed"``: the energy stopped decreasing (by the tolerance), the
+        pins were reached and the held lengths kept, within ``max_iterations``.
+        True for the growers.
+    energy : str
+        ``"relaxed"`` only: the energy minimised (``"arap"``, ``"hybrid"`` or
+        ``"symmetric-dirichlet"``; what ``"auto"`` chose); "" otherwise.
+    length_error : float
+        ``"relaxed"`` with ``lengths``: the largest ``|l_flat / l_held - 1|`` over
+        the held edges; 0 otherwise.
+    """
+
+    uv: np.ndarray
+    vertices: np.ndarray
+    faces: np.ndarray
+    loops: tuple
+    method: str
+    seed_face: int
+    overlap: Overlap
+    start: str = ""
+    iterations: int = 0
+    converged: bool = True
+    energy: str = ""
+    length_error: float = 0.0
+
+    @property
+    def one_to_one(self) -> bool:
+        """True when the flat pattern does not overlap itself anywhere."""
+        return self.overlap.one_to_one
+
+    @property
+    def n_folded(self) -> int:
+        """Number of folded (flipped or collapsed) triangles."""
+        return self.overlap.n_folded
+
+    @cached_property
+    def distortion(self) -> Distortion:
+        """Principal strains, edge strain, areas and boundary lengths."""
+        return distortion(self.vertices, self.faces, self.uv, loops=self.loops)
 
 
 @dataclass(frozen=True, eq=False)

@@ -138,6 +138,7 @@ def test_the_distortion_summary_against_independent_numbers():
     tri = f[len(f) // 2]
     folded[tri[0]] = folded[tri[1]] + folded[tri[2]] - folded[tri[0]]  # reflected across the opposite side
     df = measure.distortion(v, f, folded)
+    assert np.isnan(df.boundary_3d) and np.isnan(df.boundary_flat)  # no loops given: not measured
     q = folded[f]
     signed = ((q[:, 1, 0] - q[:, 0, 0]) * (q[:, 2, 1] - q[:, 0, 1]) - (q[:, 1, 1] - q[:, 0, 1]) * (q[:, 2, 0] - q[:, 0, 0]))
     assert df.n_folded == np.sum(signed <= 0) >= 1 and df.symmetric_dirichlet == float("inf")

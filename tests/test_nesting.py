@@ -47,3 +47,22 @@ def test_the_grain_stays_along_the_roll(plates):
     for flat in nest.pattern.panels:
         angle = flat.placement[0] % np.pi
         assert min(angle, np.pi - angle) < 1e-9
+
+
+def test_four_equal_rectangles_pack_two_by_two():
+    """Four 100 x 50 rectangles on a 211 mm roll with a 10 mm gap: two fit side by side, so the
+    shortest marker is two rows, 50 + 10 + 50 = 110 mm long.  The nester keeps 0.5 mm more than
+    the gap (its collision shapes are simplified within 0.25 mm and widened by as much), so two
+    rows take at most 110.5 mm, and three rows (171 mm) would mean a worse search."""
+    from patterns.reading import mesh_model
+
+    x, y = np.meshgrid(np.linspace(0, 100, 5), np.linspace(0, 50, 3))
+    grid = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    quads = [(r * 5 + c, r * 5 + c + 1, (r + 1) * 5 + c + 1, (r + 1) * 5 + c) for r in range(2) for c in range(4)]
+    tri = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
+    v = np.vstack([grid + [0, 0, 300.0 * k] for k in range(4)])
+    f = np.vstack([tri + len(grid) * k for k in range(4)])
+    pattern = patterns.flatten(mesh_model(v, f, name="rects"), method="isometric", grain=(0, 1, 0))  # axis-aligned
+    nest = pattern.layout(width=211.0, gap=10.0, allow_rotation=False, step=1.0)
+    assert 110.0 <= nest.length <= 110.5 + 1e-6
+    assert nest.efficiency == pytest.approx(4 * 100 * 50 / (211.0 * nest.length), rel=1e-9)

@@ -12,7 +12,8 @@
   (:mod:`~patterns.flattening.darts`) and grain (:mod:`~patterns.flattening.grain`).
 """
 
-from .engine import Flattening, flatten_mesh
+from ..pattern import Flattening
+from .engine import flatten_mesh
 from .panels import flatten
 from .settings import METHODS, FlattenOptions
 

@@ -13,7 +13,8 @@ from scipy.sparse import csgraph
 from ..cut import cut_along
 from ..measure import strain_rms, triangle_strains
 from ..mesh import edge_graph, unique_edges, unique_ints
-from .engine import Flattening, flatten_mesh
+from ..pattern import Flattening
+from .engine import flatten_mesh
 from .seams import seam_edges
 
 __all__ = ["cut_darts", "strained_depths"]

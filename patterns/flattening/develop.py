@@ -28,8 +28,8 @@ from ..measure import signed_areas
 from ..mesh import _readonly, validate_mesh
 from ..model import SurfaceKind
 from ..options import check_number
+from ..pattern import Flattening
 from ..predicates import overlap_verdict
-from .engine import Flattening
 from .settings import REFERENCES
 
 __all__ = ["REFERENCES", "develop", "developed", "neutral_offset", "offset_along_normals", "offset_points"]

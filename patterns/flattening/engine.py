@@ -8,91 +8,22 @@ numbering the engine works in.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import cached_property
-
 import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..errors import FlattenError, InputError, PatternsError
-from ..measure import Distortion, distortion, local_coordinates, signed_areas
+from ..measure import local_coordinates, signed_areas
 from ..mesh import _readonly, as_mesh_arrays, validate_mesh
 from ..options import is_number
-from ..predicates import Overlap, overlap_verdict
+from ..pattern import Flattening
+from ..predicates import overlap_verdict
 from . import grow
 from .embed import lscm, tutte_embedding
 from .numbering import dissection_order, renumber, renumber_connectivity, spatial_order
 from .relax import align_to_pins, best_scale, check_lengths, check_pins, is_isometric, relax
-from .settings import METHODS, FlattenOptions
+from .settings import FlattenOptions
 
-__all__ = ["METHODS", "Flattening", "flatten_mesh"]
-
-@dataclass(frozen=True, eq=False)
-class Flattening:
-    """The result of :func:`flatten_mesh`.
-
-    Attributes
-    ----------
-    uv : (n, 2) float64
-        Flat position of every input vertex, in the input's vertex order and
-        unit, at true scale (read-only).
-    vertices : (n, 3) float64
-        The validated input vertices (read-only).
-    faces : (m, 3) int64
-        The validated input faces (read-only).
-    loops : tuple of (k,) int64
-        Boundary loops (vertex indices, surface to their left; longest first).
-    method : str
-    seed_face : int
-        The triangle the greedy grower laid down first, without distortion.
-    overlap : Overlap
-        The overlap verdict: folded triangles, loop tests, ``one_to_one``.
-    start : str
-        ``"relaxed"`` only: the layout the relaxation started from --
-        ``"greedy"`` (the isometric grower's, when it is one-to-one), else
-        ``"lscm"`` (when that is one-to-one), else ``"tutte"``; "" otherwise.
-    iterations : int
-        ``"relaxed"`` only: relaxation iterations run (0 otherwise).
-    converged : bool
-        ``"relaxed"``: the energy stopped decreasing (by the tolerance), the
-        pins were reached and the held lengths kept, within ``max_iterations``.
-        True for the growers.
-    energy : str
-        ``"relaxed"`` only: the energy minimised (``"arap"``, ``"hybrid"`` or
-        ``"symmetric-dirichlet"``; what ``"auto"`` chose); "" otherwise.
-    length_error : float
-        ``"relaxed"`` with ``lengths``: the largest ``|l_flat / l_held - 1|`` over
-        the held edges; 0 otherwise.
-    """
-
-    uv: np.ndarray
-    vertices: np.ndarray
-    faces: np.ndarray
-    loops: tuple
-    method: str
-    seed_face: int
-    overlap: Overlap
-    start: str = ""
-    iterations: int = 0
-    converged: bool = True
-    energy: str = ""
-    length_error: float = 0.0
-
-    @property
-    def one_to_one(self) -> bool:
-        """True when the flat pattern does not overlap itself anywhere."""
-        return self.overlap.one_to_one
-
-    @property
-    def n_folded(self) -> int:
-        """Number of folded (flipped or collapsed) triangles."""
-        return self.overlap.n_folded
-
-    @cached_property
-    def distortion(self) -> Distortion:
-        """Principal strains, edge strain, areas and boundary lengths."""
-        return distortion(self.vertices, self.faces, self.uv, loops=self.loops)
-
+__all__ = ["flatten_mesh"]
 
 def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | None = None,
                  pins=None, max_iterations: int = 500, energy_tolerance: float = 1e-5,

@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import InputError
 from ..measure import flat_direction
 from ..mesh import _readonly
-from .engine import Flattening
+from ..pattern import Flattening
 
 __all__ = ["grain_table", "turn_to_grain"]
 

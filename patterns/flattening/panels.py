@@ -14,10 +14,10 @@ import numpy as np
 from ..errors import InputError
 from ..mesh import polyline_length, unique_edges
 from ..model import Model
-from ..pattern import FlatPanel, FlatSeam, Pattern
+from ..pattern import FlatPanel, FlatSeam, Flattening, Pattern
 from .darts import cut_darts
 from .develop import developed, neutral_offset, offset_along_normals
-from .engine import Flattening, flatten_mesh
+from .engine import flatten_mesh
 from .grain import grain_table, turn_to_grain
 from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
 from .settings import FlattenOptions
