@@ -1,0 +1,114 @@
+"""The house rules that code review would otherwise have to remember: small classes and
+functions, no import cycle, layers that point down, no module named like one of its functions."""
+
+import ast
+import importlib
+import pkgutil
+from pathlib import Path
+
+import pytest
+
+import patterns
+
+PACKAGE = Path(patterns.__file__).parent
+MAX_CLASS_LINES = 250
+MAX_FUNCTION_LINES = 80  # lines of code: docstring, blank and comment lines not counted
+
+
+def _sources():
+    return sorted(p for p in PACKAGE.rglob("*.py"))
+
+
+def _code_lines(node, lines) -> int:
+    body = node.body
+    if body and isinstance(body[0], ast.Expr) and isinstance(getattr(body[0], "value", None), ast.Constant) \
+            and isinstance(body[0].value.value, str):
+        body = body[1:]
+    seen = set()
+    for stmt in body:
+        for ln in range(stmt.lineno, stmt.end_lineno + 1):
+            text = lines[ln - 1].strip()
+            if text and not text.startswith("#"):
+                seen.add(ln)
+    return len(seen)
+
+
+def test_no_class_or_function_is_too_long():
+    too_long = []
+    for path in _sources():
+        lines = path.read_text().splitlines()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ClassDef) and node.end_lineno - node.lineno + 1 > MAX_CLASS_LINES:
+                too_long.append(f"{path.name}: class {node.name}")
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and path.name != "cli.py" \
+                    and _code_lines(node, lines) > MAX_FUNCTION_LINES:
+                too_long.append(f"{path.name}: {node.name} ({_code_lines(node, lines)} lines)")
+    assert not too_long, too_long
+
+
+def _imports():
+    """``{module: {imported patterns module, ...}}`` from every import, module- or function-level."""
+    graph = {}
+    for path in _sources():
+        rel = path.relative_to(PACKAGE.parent).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        name = ".".join(parts)
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        found = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = package.split(".")
+                    base = base[:len(base) - node.level + 1]
+                    target = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    target = node.module or ""
+                if target.startswith("patterns"):
+                    submodules = [f"{target}.{a.name}" for a in node.names
+                                  if _is_package(target) and importlib.util.find_spec(f"{target}.{a.name}")]
+                    found |= set(submodules) if submodules else {target}  # "from . import grow": the module
+            elif isinstance(node, ast.Import):
+                found |= {a.name for a in node.names if a.name.startswith("patterns")}
+        graph[name] = found - {name}
+    return graph
+
+
+def _is_package(name):
+    spec = importlib.util.find_spec(name)
+    return spec is not None and spec.submodule_search_locations is not None
+
+
+def test_no_import_cycle():
+    graph = _imports()
+
+    def reach(start):
+        seen, todo = set(), [start]
+        while todo:
+            for nxt in graph.get(todo.pop(), ()):
+                if nxt not in seen:
+                    seen.add(nxt)
+                    todo.append(nxt)
+        return seen
+
+    cycles = [m for m in graph if m in reach(m) and m != "patterns"]
+    assert not cycles, cycles
+
+
+def test_no_module_shares_a_name_with_a_function_of_the_package():
+    """`patterns.check` is the function; its module is `patterns.audit` (and so on)."""
+    modules = {m.name for m in pkgutil.iter_modules(patterns.__path__)}
+    functions = {n for n in patterns.__all__ if callable(getattr(patterns, n)) and n[0].islower()}
+    assert not modules & functions, modules & functions
+    for name in ("audit", "flattening", "nesting", "reading"):
+        module = importlib.import_module(f"patterns.{name}")
+        assert module.__name__ == f"patterns.{name}"
+    assert patterns.audit.Severity is patterns.Severity
+
+
+@pytest.mark.parametrize("name", sorted(patterns.__all__))
+def test_every_export_is_documented(name):
+    obj = getattr(patterns, name)
+    if callable(obj) and not isinstance(obj, type(patterns)):
+        assert (obj.__doc__ or "").strip(), name
