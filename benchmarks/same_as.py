@@ -9,12 +9,15 @@ defaults, each in its own process (the earlier one from a temporary ``git worktr
 best of ``--repeats``; the table gives the SHA-1 of each ``uv`` array, whether they are equal, and
 the time of this checkout over the earlier one's (the peer, in the same run).  When every layout
 is bitwise equal, every strain, fold count and verdict of that commit's benchmark holds unchanged.
+(Both run in this process's environment: OpenBLAS picks its kernels by CPU type, and another
+kernel rounds dot products differently, so the SHA-1 values themselves belong to this machine.)
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -40,8 +43,7 @@ print(json.dumps({"sha": hashlib.sha1(np.ascontiguousarray(r.uv).tobytes()).hexd
 
 def _run(root: Path, mesh: Path, repeats: int) -> dict:
     proc = subprocess.run([sys.executable, "-c", _RUN, str(mesh), str(repeats)], capture_output=True, text=True,
-                          env={"PYTHONPATH": str(root), "PATH": "/usr/bin:/bin", "OPENBLAS_NUM_THREADS": "1"},
-                          check=True)
+                          env=dict(os.environ, PYTHONPATH=str(root)), check=True)
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
