@@ -253,8 +253,10 @@ def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
     options : CheckOptions, optional
         The limits as a record; keywords (``max_strain``: largest acceptable
         triangle strain, 0.03 = 3 %, triangles above it are reported with the
-        share of area they cover; ``max_seam_mismatch``: largest acceptable
-        difference between the two flat lengths of a seam, mm) go over it.
+        share of area they cover -- by default the limit the pattern was
+        flattened to, :attr:`Pattern.max_strain`; ``max_seam_mismatch``:
+        largest acceptable difference between the two flat lengths of a seam,
+        mm) go over it.
 
     Returns
     -------
@@ -276,6 +278,8 @@ def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
         raise InputError(f"check() takes a patterns.Pattern (from patterns.flatten), got {type(pattern).__name__}")
     opts = CheckOptions.of(options, keywords, name=pattern.name)
     max_strain, max_seam_mismatch = opts.max_strain, opts.max_seam_mismatch
+    if max_strain is None:
+        max_strain = pattern.max_strain  # the limit the pattern was flattened (and darted) to travels with it
     findings = []
     panel_reports = []
     for flat in pattern.panels:

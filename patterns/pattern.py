@@ -317,6 +317,10 @@ class Pattern:
         In the model's seam order.
     method : str
         The flattening method used.
+    max_strain : float or None
+        The strain limit the pattern was flattened to (``flatten(max_strain=...)``,
+        which cut darts to meet it): :func:`patterns.check` judges against it
+        unless told another limit.
     """
 
     model: Model
@@ -329,6 +333,7 @@ class Pattern:
     laid_out: bool = False
     """True once the panels have been placed on a sheet (:meth:`placed`): only
     then are panels checked against each other."""
+    max_strain: float | None = None
 
     @property
     def name(self) -> str:

@@ -223,3 +223,16 @@ def test_squared_seam_allowance_corners(cup_pattern, tmp_path):
     assert abs(outlines["square"].area - outlines["mitre"].area) > 1.0
     with pytest.raises(InputError, match="seam_corners"):
         laid.to_dxf(tmp_path / "x.dxf", seam_allowance=10.0, seam_corners="round")
+
+
+def test_the_strain_limit_travels_with_the_pattern():
+    """flatten(max_strain=...) records its limit; check() judges against it unless told otherwise
+    (a darted pattern still above its limit is not called ok by a check without arguments)."""
+    model = patterns.load(SAMPLES / "cup.step")
+    pattern = patterns.flatten(model, max_strain=0.02, max_darts=2)
+    assert pattern.max_strain == 0.02
+    report = patterns.check(pattern)
+    worst = max(p.strain_max for p in report.panels)
+    assert worst > 0.02 and not report.ok  # two darts per quarter sphere cannot reach 2 %
+    assert patterns.check(pattern, max_strain=0.5).ok  # another limit, when asked
+    assert patterns.flatten(model).max_strain is None and patterns.check(patterns.flatten(model)).ok

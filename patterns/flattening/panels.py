@@ -118,7 +118,8 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
         held_at = tuple(targets.get((seam.id, side)) for side in range(2))
         seams_out.append(FlatSeam(seam, lengths, None if None in held_at else held_at))
     return Pattern(model=model, panels=tuple(flat), seams=tuple(seams_out), method=method,
-                   thickness=opts.thickness, k_factor=opts.k_factor, reference=opts.reference)
+                   thickness=opts.thickness, k_factor=opts.k_factor, reference=opts.reference,
+                   max_strain=opts.max_strain)
 
 
 def _flat_length(result: Flattening, edges: np.ndarray, idx) -> float:
