@@ -113,9 +113,8 @@ def layout(pattern, *, width: float, gap: float = 10.0, margin: float = 0.0, all
     width = check_number(width, "width (mm)", low=0, low_open=True, name=pattern.name)
     gap = check_number(gap, "gap (mm)", low=0, name=pattern.name)
     margin = check_number(margin, "margin (mm)", low=0, name=pattern.name)
-    step = float(step) if step is not None else width / 150.0
-    if not step > 0:
-        raise InputError(f"{pattern.name}: step must be a positive number of mm, got {step!r}")
+    step = width / 150.0 if step is None else check_number(step, "step (mm)", low=0, low_open=True,
+                                                           name=pattern.name)
     shapes, outlines, base = [], [], []
     for flat in pattern.panels:
         uv = flat.flattening.uv

@@ -49,20 +49,62 @@ def test_the_grain_stays_along_the_roll(plates):
         assert min(angle, np.pi - angle) < 1e-9
 
 
+def _rectangles(sizes, name="rects"):
+    """Flat rectangles ``(width along x, height along y)`` mm, as panels with their grain along +Y."""
+    from patterns.reading import mesh_model
+
+    vs, fs, offset = [], [], 0
+    for k, (w, h) in enumerate(sizes):
+        x, y = np.meshgrid(np.linspace(0, w, 5), np.linspace(0, h, 3))
+        grid = np.column_stack([x.ravel(), y.ravel(), np.full(x.size, 500.0 * k)])
+        quads = [(r * 5 + c, r * 5 + c + 1, (r + 1) * 5 + c + 1, (r + 1) * 5 + c) for r in range(2) for c in range(4)]
+        tri = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
+        vs.append(grid)
+        fs.append(tri + offset)
+        offset += len(grid)
+    return patterns.flatten(mesh_model(np.vstack(vs), np.vstack(fs), name=name), method="isometric",
+                            grain=(0, 1, 0))
+
+
 def test_four_equal_rectangles_pack_two_by_two():
     """Four 100 x 50 rectangles on a 211 mm roll with a 10 mm gap: two fit side by side, so the
     shortest marker is two rows, 50 + 10 + 50 = 110 mm long.  The nester keeps 0.5 mm more than
     the gap (its collision shapes are simplified within 0.25 mm and widened by as much), so two
     rows take at most 110.5 mm, and three rows (171 mm) would mean a worse search."""
-    from patterns.reading import mesh_model
-
-    x, y = np.meshgrid(np.linspace(0, 100, 5), np.linspace(0, 50, 3))
-    grid = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
-    quads = [(r * 5 + c, r * 5 + c + 1, (r + 1) * 5 + c + 1, (r + 1) * 5 + c) for r in range(2) for c in range(4)]
-    tri = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
-    v = np.vstack([grid + [0, 0, 300.0 * k] for k in range(4)])
-    f = np.vstack([tri + len(grid) * k for k in range(4)])
-    pattern = patterns.flatten(mesh_model(v, f, name="rects"), method="isometric", grain=(0, 1, 0))  # axis-aligned
+    pattern = _rectangles([(100.0, 50.0)] * 4)
     nest = pattern.layout(width=211.0, gap=10.0, allow_rotation=False, step=1.0)
     assert 110.0 <= nest.length <= 110.5 + 1e-6
     assert nest.efficiency == pytest.approx(4 * 100 * 50 / (211.0 * nest.length), rel=1e-9)
+
+
+def test_a_long_panel_is_turned_across_only_when_the_grain_may_turn():
+    """A 300 x 40 panel on a 100 mm roll fits only turned by 90 degrees: allowed without the
+    grain, refused with it (the grain must stay along the roll) or without rotation."""
+    pattern = _rectangles([(300.0, 40.0)])
+    nest = pattern.layout(width=100.0, respect_grain=False)
+    (flat,) = nest.pattern.panels
+    turned = flat.placement[0] % np.pi
+    assert abs(turned - np.pi / 2) < 1e-9
+    assert np.ptp(flat.uv[:, 0]) == pytest.approx(40.0, abs=1e-6) and nest.length == pytest.approx(300.0, abs=1e-6)
+    for kwargs in ({"respect_grain": True}, {"respect_grain": False, "allow_rotation": False}):
+        with pytest.raises(LayoutError, match="wider than the 100 mm roll"):
+            pattern.layout(width=100.0, **kwargs)
+
+
+def test_the_margin_is_kept_around_each_outline():
+    """A margin (a seam allowance added later) keeps the outlines gap + 2 x margin apart."""
+    nest = _rectangles([(100.0, 50.0)] * 3).layout(width=400.0, gap=10.0, margin=5.0)
+    polys = _outlines(nest.pattern)
+    assert min(polys[i].distance(polys[j]) for i in range(3) for j in range(i + 1, 3)) >= 20.0 - 1e-6
+    x = np.concatenate([np.asarray(p.exterior.coords)[:, 0] for p in polys])
+    assert x.min() >= 5.0 - 1e-6 and x.max() <= 400.0 - 5.0 + 1e-6  # the margin inside the roll too
+
+
+@pytest.mark.parametrize(("kwargs", "words"), [({"width": 0.0}, "width"), ({"width": 100.0, "gap": -1.0}, "gap"),
+                                               ({"width": 100.0, "margin": -1.0}, "margin"),
+                                               ({"width": 100.0, "step": 0.0}, "step")])
+def test_bad_layout_options(plates, kwargs, words):
+    from patterns.errors import InputError
+
+    with pytest.raises(InputError, match=words):
+        plates.layout(**kwargs)
