@@ -358,3 +358,34 @@ def test_every_finding_code_is_produced_by_a_test():
         test_every_finding_code_is_produced_by_a_test.__doc__, "")
     missing = [c.name for c in Code if f"Code.{c.name}" not in text]  # Code.X or patterns.Code.X
     assert not missing, missing
+
+
+def test_the_json_report_is_the_documented_schema(cup, tmp_path):
+    """The report of the cup at 3 % has exactly the keys, units and (rounded) numbers of the
+    example in docs/report.md, is indented by two spaces in the order shown, and a folder that
+    does not exist is refused naming the report."""
+    import json
+    import pathlib
+    import re
+
+    doc = (pathlib.Path(__file__).parent.parent / "docs" / "report.md").read_text()
+    example = json.loads(re.search(r"```json\n(.*?)\n```", doc, re.S).group(1))
+    path = tmp_path / "cup.json"
+    patterns.check(cup, max_strain=0.03).to_json(path)
+    text = path.read_text(encoding="utf-8")
+    got = json.loads(text)
+    assert list(got) == list(example)  # the same keys, in the documented order
+    assert text.startswith('{\n  "schema": "patterns.report/2",\n  "pattern": "cup.step"') and text.endswith("}\n")
+    assert got["units"] == example["units"] and got["limits"] == example["limits"]
+    for key in ("panels", "seams", "findings"):
+        assert set(got[key][0]) == set(example[key][0]), key
+    for key in ("panels", "seams"):
+        for name, value in example[key][0].items():
+            if isinstance(value, float) or (isinstance(value, list) and value and isinstance(value[0], float)):
+                assert got[key][0][name] == pytest.approx(value, abs=1e-4), name
+            else:
+                assert got[key][0][name] == value, name
+    assert got["findings"][0]["code"] == example["findings"][0]["code"]
+    assert got["findings"][0]["message"] == example["findings"][0]["message"]
+    with pytest.raises(patterns.ExportError, match="cannot write the report"):
+        patterns.check(cup).to_json(tmp_path / "missing" / "cup.json")
