@@ -74,3 +74,40 @@ def test_offsetting_a_cylinder_moves_points_radially():
     moved = offset_points(_surface(SurfaceKind.CYLINDER, radius=r), pts, 1.5)
     np.testing.assert_allclose(np.hypot(moved[:, 0], moved[:, 1]), r + 1.5, rtol=1e-12)
     np.testing.assert_allclose(moved[:, 2], pts[:, 2], atol=1e-12)
+
+
+def test_a_general_cone_unrolls_by_its_directrix():
+    """A right circular cone given as a general cone (apex and a sampled directrix, as a
+    square-to-round transition's corner faces are): the same polar development as the analytic
+    cone, between the directrix's samples too."""
+    a, height = np.radians(25.0), 200.0
+    u = np.linspace(0.0, 2 * np.pi / 3, 2001)
+    rim = height * np.tan(a)
+    directrix = np.column_stack([rim * np.cos(u), rim * np.sin(u), np.full(len(u), height)])
+    cone = Surface(kind=SurfaceKind.GENERAL_CONE, origin=np.zeros(3), x_dir=np.zeros(3), y_dir=np.zeros(3),
+                   axis=np.zeros(3), directrix=directrix)
+    rng = np.random.default_rng(4)
+    pu = rng.uniform(0.01, 2 * np.pi / 3 - 0.01, 40)  # between samples
+    h = rng.uniform(20.0, 190.0, 40)
+    pts = np.column_stack([h * np.tan(a) * np.cos(pu), h * np.tan(a) * np.sin(pu), h])
+    uv = develop(cone, np.vstack([np.zeros(3), pts]))
+    np.testing.assert_allclose(uv[0], 0.0, atol=1e-12)  # the apex
+    s = h / np.cos(a)
+    np.testing.assert_allclose(np.hypot(uv[1:, 0], uv[1:, 1]), s, rtol=1e-12)
+    np.testing.assert_allclose(np.arctan2(uv[1:, 1], uv[1:, 0]), pu * np.sin(a), atol=1e-7)
+
+
+def test_offsetting_small_triangles_moves_by_the_offset_along_the_normal():
+    """A fine freeform mesh (triangles well under 1 mm^2): every vertex moves by exactly the
+    offset, along the unit normal of the surface (a sphere: radially)."""
+    from patterns.flattening.develop import offset_along_normals
+    from patterns.model import Panel
+    from patterns.mesh import validate_mesh
+    from patterns import surfaces
+
+    v, f = surfaces.spherical_cap(radius=5.0, half_angle=40.0, n_faces=2000)  # areas ~0.01 mm^2
+    v, f, conn = validate_mesh(v, f)
+    moved = offset_along_normals(Panel("cap", v, f, conn.loops), 0.3)
+    np.testing.assert_allclose(np.linalg.norm(moved - v, axis=1), 0.3, rtol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(v, axis=1), 5.0, rtol=1e-9)  # the cap's sphere: centred at 0
+    np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 5.3, rtol=1e-3)  # outwards, about radially
