@@ -39,10 +39,7 @@ MODULES = {  # the module mutated and the tests that answer for it (its unit tes
     "patterns/flattening/develop.py": ["tests/test_develop.py",
                                        "tests/test_sheet_metal.py::test_cone_frustum_blank_is_the_analytic_annular_sector",
                                        "tests/test_sheet_metal.py::test_rolled_cylinder_blank_length_with_thickness_and_k_factor",
-                                       "tests/test_sheet_metal.py::test_cone_neutral_surface_with_thickness",
-                                       "tests/test_sheet_metal.py::test_freeform_thickness_offsets_along_the_normal",
-                                       "tests/test_sheet_metal.py::test_planar_faces_and_holes_unroll_exactly",
-                                       "tests/test_sheet_metal.py::test_square_to_round_is_unrolled_exactly_like_the_hand_layout"],
+                                       "tests/test_sheet_metal.py::test_planar_faces_and_holes_unroll_exactly"],
     "patterns/nesting.py": ["tests/test_nesting.py"],
 }
 
@@ -94,17 +91,17 @@ def main(argv=None) -> int:
     python = _venv()
     total_k = total_s = 0
     rows = []
+    print("| module | mutants | killed (timeouts included) | survived | score |")
+    print("|---|---|---|---|---|", flush=True)
     for module in args.modules:
         r = run(module, MODULES.get(module, ["tests/"]), python)
         killed = r["killed"] + r["timeout"]
         total_k, total_s = total_k + killed, total_s + r["survived"]
         score = killed / max(killed + r["survived"], 1)
         rows.append(f"| `{module}` | {killed + r['survived']} | {killed} | {r['survived']} | {score:.1%} |")
+        print(rows[-1], flush=True)
         for name in r["survivors"]:
-            print(f"survived: {name}", file=sys.stderr)
-    print("| module | mutants | killed (timeouts included) | survived | score |")
-    print("|---|---|---|---|---|")
-    print("\n".join(rows))
+            print(f"survived: {name}", file=sys.stderr, flush=True)
     print(f"| all | {total_k + total_s} | {total_k} | {total_s} | {total_k / max(total_k + total_s, 1):.1%} |")
     return 0
 
