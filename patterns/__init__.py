@@ -12,7 +12,7 @@ The public API, all importable from the top level::
     result.overlap.one_to_one, result.distortion.strain_rms
 """
 
-from .audit import CheckOptions, Code, Finding, PanelReport, Report, SeamReport, Severity, check
+from .audit import CheckOptions, Code, DartReport, Finding, PanelReport, Report, SeamReport, Severity, check
 from .cut import Cut, cut_to_disk
 from .errors import (
     CadError,
@@ -32,7 +32,7 @@ from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
 from .model import Bookkeeping, Model, Panel, Seam, Surface, SurfaceKind
 from .nesting import Layout, layout
-from .pattern import FlatPanel, FlatSeam, Pattern
+from .pattern import Dart, FlatPanel, FlatSeam, Pattern
 from .predicates import Overlap, overlap_verdict
 from .reading import LoadOptions, load, read_cad, read_mesh
 from .tessellate import MeshingOptions, mesh_shape, tessellate_face
@@ -49,6 +49,8 @@ __all__ = [
     "Code",
     "Connectivity",
     "Cut",
+    "Dart",
+    "DartReport",
     "Distortion",
     "DxfOptions",
     "Ease",

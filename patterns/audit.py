@@ -15,12 +15,12 @@ import shapely
 from .errors import InputError
 from .files import atomic_output
 from .measure import edge_strain, folded_faces, strain_stats
-from .mesh import _readonly, polyline_length
+from .mesh import _readonly
 from .options import Options, option
 from .pattern import Pattern
 from .predicates import Overlap, boundary_crossings, crossing_segments, flat_polygon, overlap_verdict
 
-__all__ = ["REPORT_SCHEMA", "CheckOptions", "Code", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
+__all__ = ["REPORT_SCHEMA", "CheckOptions", "Code", "DartReport", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
            "boundary_crossings", "check", "crossing_segments", "overlap_verdict"]
 
 
@@ -133,8 +133,20 @@ class PanelReport:
     converged: bool
     energy: str = ""
     """The energy the relaxation minimised (``"arap"``, ``"hybrid"``, ...); "" for a grower or an exact development."""
-    darts: int = 0
-    """Darts cut by ``flatten(..., max_strain=...)``."""
+    darts: tuple = ()
+    """The :class:`DartReport` of each dart cut by ``flatten(..., max_strain=...)``."""
+
+
+@dataclass(frozen=True)
+class DartReport:
+    """One dart of a panel (lengths in mm): its legs are sewn together, so they count as a seam."""
+
+    length_3d: float
+    """The cut's length on the 3D surface."""
+    legs_flat: tuple
+    """The flat length of each leg (equal: they close on each other)."""
+    tip: tuple
+    """``(x, y)`` of the dart's point in the flat pattern as placed (a drill hole marks it)."""
 
 
 @dataclass(frozen=True)
@@ -161,7 +173,7 @@ class SeamReport:
     """``mismatch / length_3d * 100``."""
 
 
-REPORT_SCHEMA = "patterns.report/2"
+REPORT_SCHEMA = "patterns.report/3"
 """The ``schema`` value of :meth:`Report.to_dict` (see docs/report.md)."""
 
 
@@ -207,7 +219,9 @@ class Report:
             "ok": self.ok,
             "units": {"length": "mm", "area": "mm2", "strain": "ratio (0.01 = 1 %)"},
             "limits": {"max_strain": self.max_strain, "max_seam_mismatch": self.max_seam_mismatch},
-            "panels": [{**asdict(p), "strain_max_at": list(p.strain_max_at)} for p in self.panels],
+            "panels": [{**asdict(p), "strain_max_at": list(p.strain_max_at),
+                        "darts": [{"length_3d": d.length_3d, "legs_flat": list(d.legs_flat), "tip": list(d.tip)}
+                                  for d in p.darts]} for p in self.panels],
             "seams": [{**asdict(s), "panels": list(s.panels), "length_flat": list(s.length_flat),
                        "length_held": None if s.length_held is None else list(s.length_held)}
                       for s in self.seams],
@@ -326,8 +340,8 @@ def _panel_report(flat, max_strain):
     res = flat.flattening
     none = np.zeros(0, dtype=np.int64)
     if flat.darts:
-        tips = np.array([uv[d[-1]] for d in flat.darts])
-        length = sum(polyline_length(vertices[d]) for d in flat.darts)
+        tips = np.array([uv[d.tip] for d in flat.darts])
+        length = sum(d.length_3d for d in flat.darts)
         findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), _readonly(tips), none,
                                 None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
                                       f"the limit ({length:.1f} mm of cuts; points: their tips)"))
@@ -343,7 +357,9 @@ def _panel_report(flat, max_strain):
         share_above_limit=share,
         edge_strain_rms=float(np.sqrt(np.mean(es**2))), edge_strain_max=float(es.max()),
         n_folded=int(np.count_nonzero(ts.area_change <= -1.0)), one_to_one=bool(res.one_to_one),
-        iterations=int(res.iterations), converged=bool(res.converged), energy=res.energy, darts=len(flat.darts))
+        iterations=int(res.iterations), converged=bool(res.converged), energy=res.energy,
+        darts=tuple(DartReport(float(d.length_3d), d.leg_lengths(uv), tuple(float(x) for x in uv[d.tip]))
+                    for d in flat.darts))
     return report, findings
 
 

@@ -33,7 +33,7 @@ from .mesh import (
     trace_loops,
 )
 
-__all__ = ["Cut", "cut_along", "cut_to_disk", "pieces"]
+__all__ = ["Cut", "Inserted", "cut_along", "cut_to_disk", "insert_line", "pieces"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -263,24 +263,177 @@ def _cut_along(vertices, faces, t, paths) -> Cut:
 
 
 def cut_along(vertices: np.ndarray, faces: np.ndarray, path, *, name: str = "mesh") -> Cut:
-    """Cut a mesh along one path of edges (a slit or a dart from the boundary).
+    """Cut a mesh along paths of edges (slits, or darts from the boundary).
 
     Parameters
     ----------
     vertices : (n, 3) float64
     faces : (m, 3) int64
-    path : (p,) int64
-        Vertex indices joined by mesh edges; where it starts or ends on the
-        boundary the cut opens there, where it ends inside the surface the slit
-        stops.
+    path : (p,) int64, or a sequence of them
+        Vertex indices joined by mesh edges; where a path starts or ends on
+        the boundary the cut opens there, where it ends inside the surface
+        the slit stops.  Several paths are cut at once.
     name : str
 
     Returns
     -------
     Cut
-        The input vertices keep their indices; the copies on the cut's second
-        side come after them.
+        The input vertices keep their indices; the copies on the cuts'
+        second sides come after them.
     """
-    path = np.asarray(path, dtype=np.int64)
+    paths = [path] if np.ndim(path[0]) == 0 else list(path)
+    paths = [np.asarray(p, dtype=np.int64) for p in paths]
     t = edge_tables(faces, len(vertices), name=name)
-    return _cut_along(vertices, faces, t, [path])
+    return _cut_along(vertices, faces, t, paths)
+
+
+@dataclass(frozen=True, eq=False)
+class Inserted:
+    """A mesh with a line inserted along its edges (read-only arrays).
+
+    Attributes
+    ----------
+    vertices : (k, 3) float64
+        The input vertices followed by the points made where the line crosses
+        an edge (on that edge: the surface is unchanged).
+    faces : (m', 3) int64
+        The input faces, those the line crosses split along it (winding kept).
+    uv : (k, 2) float64
+        The layout, extended to the new points the same way.
+    path : (p,) int64
+        The line as a path of vertices joined by edges of ``faces``, from
+        ``start`` towards ``end``.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    uv: np.ndarray
+    path: np.ndarray
+
+
+def insert_line(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, start, end, *,
+                snap: float = 0.25, keep_off=None) -> Inserted:
+    """Insert the straight line from ``start`` to ``end`` of a layout into the mesh as a path of edges.
+
+    A dart is drawn straight on a pattern; cut along the mesh's own edges it
+    would zigzag, and the triangles along a zigzag leg are strained for
+    nothing.  Where the segment crosses an edge a vertex is put on that edge
+    (by linear interpolation, in 3D and in the layout: the surface does not
+    move), and each crossed triangle is split along the segment.  A vertex
+    closer to the segment than ``snap`` times its edges' mean flat length is
+    taken onto the path instead (no sliver triangles).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+        Counter-clockwise in ``uv``.
+    uv : (n, 2) float64
+        A one-to-one layout of the mesh (a flattening).
+    start, end : (2,) float
+        The segment, in the layout's coordinates; the path runs from the
+        first crossing after ``start`` to the last before ``end``.
+    snap : float
+        In [0, 0.5).
+    keep_off : (k,) int, optional
+        Vertices never taken onto the path by snapping (those of lines put
+        in before, so that two lines share no vertex).
+
+    Returns
+    -------
+    Inserted
+    """
+    v, f, uv = np.asarray(vertices, dtype=np.float64), np.asarray(faces, dtype=np.int64), np.asarray(uv, np.float64)
+    a, d = np.asarray(start, dtype=np.float64), np.asarray(end, dtype=np.float64) - np.asarray(start, dtype=np.float64)
+    n = len(v)
+    edges = np.unique(np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1), axis=0)
+    flat_len = np.linalg.norm(uv[edges[:, 1]] - uv[edges[:, 0]], axis=1)
+    mean_len = np.bincount(edges.ravel(), weights=np.repeat(flat_len, 2), minlength=n) / np.maximum(
+        np.bincount(edges.ravel(), minlength=n), 1)
+    length2 = float(d @ d)
+    rel = uv - a
+    t_vertex = rel @ d / length2
+    off = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0]) / np.sqrt(length2)
+    on_line = (off < snap * mean_len) & (t_vertex >= 0) & (t_vertex <= 1)
+    if keep_off is not None:
+        on_line[np.asarray(keep_off, dtype=np.int64)] = False
+    on_line |= np.linalg.norm(rel, axis=1) == 0.0  # the start itself, when it is a vertex
+    on_line |= np.linalg.norm(uv - (a + d), axis=1) == 0.0  # and the end
+    p, e = uv[edges[:, 0]], uv[edges[:, 1]] - uv[edges[:, 0]]
+    denom = d[0] * e[:, 1] - d[1] * e[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = p - a
+        t_edge = (q[:, 0] * e[:, 1] - q[:, 1] * e[:, 0]) / denom
+        s_edge = (q[:, 0] * d[1] - q[:, 1] * d[0]) / denom
+    crossed = ((denom != 0) & (t_edge >= 0) & (t_edge <= 1) & (s_edge > 0) & (s_edge < 1)
+               & ~on_line[edges[:, 0]] & ~on_line[edges[:, 1]])
+    cross_edges, cross_s, cross_t = edges[crossed], s_edge[crossed], t_edge[crossed]
+    new_ids = n + np.arange(len(cross_edges))
+    lo, hi = cross_edges[:, 0], cross_edges[:, 1]
+    v_new = v[lo] + cross_s[:, None] * (v[hi] - v[lo])
+    uv_new = uv[lo] + cross_s[:, None] * (uv[hi] - uv[lo])
+    point_of = {(int(x), int(y)): int(k) for x, y, k in zip(lo, hi, new_ids)}
+    out_faces = _split_faces(f, point_of, np.vstack([uv, uv_new]))
+    stops = np.concatenate([np.flatnonzero(on_line), new_ids])
+    order = np.argsort(np.concatenate([t_vertex[on_line], cross_t]), kind="stable")
+    path = _joined(stops[order], out_faces, n + len(new_ids), np.vstack([v, v_new]))
+    vertices_out, uv_out = np.vstack([v, v_new]), np.vstack([uv, uv_new])
+    return Inserted(_readonly(vertices_out), _readonly(out_faces), _readonly(uv_out), _readonly(path))
+
+
+def _split_faces(faces: np.ndarray, point_of: dict, uv: np.ndarray) -> np.ndarray:
+    """Split every face with a new point on one or two of its edges (winding kept)."""
+    out = []
+    for face in faces.tolist():
+        marks = []
+        for k in range(3):
+            x, y = face[k], face[(k + 1) % 3]
+            point = point_of.get((min(x, y), max(x, y)))
+            if point is not None:
+                marks.append((k, point))
+        if not marks:
+            out.append(face)
+        elif len(marks) == 1:
+            (k, pt), = marks
+            x, y, z = face[k], face[(k + 1) % 3], face[(k + 2) % 3]
+            out += [[x, pt, z], [pt, y, z]]
+        elif len(marks) == 2:
+            (k1, p1), (k2, p2) = marks
+            if k2 != (k1 + 1) % 3:  # the points lie on edges k2 and k1: start from the earlier
+                (k1, p1), (k2, p2) = (k2, p2), (k1, p1)
+            x, y, z = face[k1], face[(k1 + 1) % 3], face[(k1 + 2) % 3]  # p1 on x-y, p2 on y-z
+            out.append([p1, y, p2])
+            first = [[x, p1, p2], [x, p2, z]]
+            second = [[x, p1, z], [p1, p2, z]]
+            out += max(first, second, key=lambda tris: min(_min_angle(uv[t]) for t in tris))
+        else:  # a straight line crosses a triangle's sides at most twice
+            raise MeshTopologyError("a straight line crossed all three sides of a triangle")
+    return np.asarray(out, dtype=np.int64).reshape(-1, 3)
+
+
+def _min_angle(points: np.ndarray) -> float:
+    """Smallest corner angle of one triangle (radians)."""
+    s = np.roll(points, -1, axis=0) - points
+    lengths = np.linalg.norm(s, axis=1)
+    cos = -(s * np.roll(s, 1, axis=0)).sum(axis=1) / np.maximum(lengths * np.roll(lengths, 1), 1e-300)
+    return float(np.arccos(np.clip(cos, -1.0, 1.0)).min())
+
+
+def _joined(stops: np.ndarray, faces: np.ndarray, n: int, vertices: np.ndarray) -> np.ndarray:
+    """The stops in order, joined by the shortest edge path wherever two in a row share no edge."""
+    edges = np.unique(np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1), axis=0)
+    known = set(map(tuple, edges.tolist()))
+    path = [int(stops[0])] if len(stops) else []
+    graph = None
+    for nxt in stops[1:].tolist():
+        if (min(path[-1], nxt), max(path[-1], nxt)) in known:
+            path.append(nxt)
+            continue
+        if graph is None:
+            graph = edge_graph(vertices, edges)
+        _, pred = csgraph.dijkstra(graph, indices=nxt, return_predecessors=True)
+        step = path[-1]
+        while step != nxt and pred[step] >= 0:
+            step = int(pred[step])
+            path.append(step)
+    return np.asarray(path, dtype=np.int64)

@@ -22,7 +22,7 @@ from .model import Model, Panel, Seam, SurfaceKind
 from .options import check_number
 from .predicates import Overlap, flat_polygon
 
-__all__ = ["FlatPanel", "FlatSeam", "Flattening", "Pattern"]
+__all__ = ["Dart", "FlatPanel", "FlatSeam", "Flattening", "Pattern"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,6 +93,39 @@ class Flattening:
 
 
 @dataclass(frozen=True, eq=False)
+class Dart:
+    """A dart: a cut from the outline into a panel, whose two legs are sewn together.
+
+    Indices are into the flattening's vertices (:attr:`FlatPanel.vertices`).
+
+    Attributes
+    ----------
+    legs : tuple of two (p,) int64
+        The vertices of each leg, from the outline to the tip (the last
+        vertex, shared by both legs).  Sewn, leg 0 meets leg 1 point by point.
+    length_3d : float
+        The cut's length on the 3D surface, mm.
+    """
+
+    legs: tuple
+    length_3d: float
+
+    @property
+    def path(self) -> np.ndarray:
+        """(p,) int64: the cut, as leg 0."""
+        return self.legs[0]
+
+    @property
+    def tip(self) -> int:
+        """The vertex at the dart's point (a drill hole marks it)."""
+        return int(self.legs[0][-1])
+
+    def leg_lengths(self, uv: np.ndarray) -> tuple:
+        """Flat length of each leg, mm, in the layout ``uv`` ``(n, 2)``."""
+        return tuple(float(np.linalg.norm(np.diff(uv[leg], axis=0), axis=1).sum()) for leg in self.legs)
+
+
+@dataclass(frozen=True, eq=False)
 class FlatPanel:
     """One panel laid flat.
 
@@ -110,8 +143,7 @@ class FlatPanel:
     flattening: Flattening
     placement: tuple = (0.0, 0.0, 0.0)
     darts: tuple = ()
-    """Cuts made by ``flatten(..., max_strain=...)``: each a ``(k,)`` int64 path of
-    vertex indices (into :attr:`vertices`), from the outline inwards."""
+    """The :class:`Dart` s cut by ``flatten(..., max_strain=...)``."""
     """``(angle, dx, dy)``: the rigid motion (radians, mm) that puts the
     flattened panel where it lies on the sheet: rotate about the origin, then
     move.  ``(0, 0, 0)`` until the pattern is laid out."""

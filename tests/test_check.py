@@ -204,7 +204,7 @@ def test_json_report_round_trips_with_its_schema(cup, tmp_path):
     path = tmp_path / "cup.json"
     report.to_json(path)
     doc = json.loads(path.read_text())
-    assert doc["schema"] == "patterns.report/2" and doc["ok"] is False and doc["pattern"] == "cup.step"
+    assert doc["schema"] == "patterns.report/3" and doc["ok"] is False and doc["pattern"] == "cup.step"
     assert doc["limits"] == {"max_strain": 0.03, "max_seam_mismatch": None}
     assert [p["name"] for p in doc["panels"]] == ["face0", "face1", "face2", "face3"]
     for p, numbers in zip(doc["panels"], report.panels):
@@ -375,7 +375,7 @@ def test_the_json_report_is_the_documented_schema(cup, tmp_path):
     text = path.read_text(encoding="utf-8")
     got = json.loads(text)
     assert list(got) == list(example)  # the same keys, in the documented order
-    assert text.startswith('{\n  "schema": "patterns.report/2",\n  "pattern": "cup.step"') and text.endswith("}\n")
+    assert text.startswith('{\n  "schema": "patterns.report/3",\n  "pattern": "cup.step"') and text.endswith("}\n")
     assert got["units"] == example["units"] and got["limits"] == example["limits"]
     for key in ("panels", "seams", "findings"):
         assert set(got[key][0]) == set(example[key][0]), key

@@ -117,7 +117,7 @@ def test_demo_runs_the_whole_pipeline(tmp_path):
         assert str(out / name) in proc.stdout or f"patterns-demo/{name}" in proc.stdout
     doc, auditor = recover.readfile(out / "cup.dxf")
     assert not auditor.has_errors and len(doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')) == 4
-    assert json.loads((out / "cup.json").read_text())["schema"] == "patterns.report/2"
+    assert json.loads((out / "cup.json").read_text())["schema"] == "patterns.report/3"
 
 
 def _batch_folder(folder: Path, n_good: int = 20) -> list[str]:

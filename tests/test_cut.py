@@ -80,3 +80,63 @@ def test_a_dart_from_the_outline_stops_inside():
     assert left[0] != right[0] and left[-1] == right[-1]  # open at the outline, closed at the tip
     assert len(cut.vertices) == len(v) + len(path) - 1
     assert len(validate_mesh(cut.vertices, cut.faces)[2].loops) == 1
+
+
+def _grid(n=12, size=100.0):
+    """A square of (n x n) cells, two triangles each, in the plane z = 0 (counter-clockwise)."""
+    xs = np.linspace(0.0, size, n + 1)
+    x, y = np.meshgrid(xs, xs)
+    v = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    k = np.arange(n * (n + 1)).reshape(n, n + 1)[:, :n].ravel()
+    f = np.vstack([np.column_stack([k, k + 1, k + n + 2]), np.column_stack([k, k + n + 2, k + n + 1])])
+    return v, f
+
+
+def test_a_line_is_put_into_the_mesh_straight_and_nothing_moves():
+    from patterns.cut import insert_line
+    from patterns.measure import signed_areas
+    from patterns.mesh import face_areas
+
+    v, f = _grid()
+    uv = v[:, :2]
+    start, end = np.array([0.0, 100.0 / 12 * 5]), np.array([63.1, 77.7])  # from a boundary vertex, across cells
+    out = insert_line(v, f, uv, start, end)
+    # The surface is the same: same area, every new point on the plane, the old vertices kept in place.
+    assert face_areas(out.vertices, out.faces).sum() == pytest.approx(100.0 * 100.0, rel=1e-12)
+    assert np.array_equal(out.vertices[: len(v)], v) and np.all(out.vertices[:, 2] == 0)
+    assert np.all(signed_areas(out.uv, out.faces) > 0)  # winding kept, nothing folded
+    # The path is the straight line: every vertex on it (to round-off, or snapped within a quarter cell)...
+    d = (end - start) / np.linalg.norm(end - start)
+    rel = out.uv[out.path] - start
+    off = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0])
+    new = out.path >= len(v)
+    h = 100.0 / 12  # a cell; a vertex's edges average 1.14 h (four sides, two diagonals)
+    assert new.sum() >= 2 and off[new].max() < 1e-9 and off.max() <= 0.25 * (4 + 2 * np.sqrt(2)) / 6 * h
+    # ... in order from the start, each step an edge of the new mesh, ending by the end point.
+    assert out.path[0] == int(np.flatnonzero(np.all(v[:, :2] == start, axis=1))[0])
+    assert np.all(np.diff(rel @ d) > 0)
+    edges = {tuple(sorted(e)) for e in np.concatenate([out.faces[:, [0, 1]], out.faces[:, [1, 2]],
+                                                       out.faces[:, [2, 0]]]).tolist()}
+    assert all(tuple(sorted(e)) in edges for e in zip(out.path[:-1].tolist(), out.path[1:].tolist()))
+    assert np.linalg.norm(out.uv[out.path[-1]] - end) < h * np.sqrt(2)
+    # Cut along it: a slit from the outline into the square, its two sides as long as the line.
+    cut = cut_along(out.vertices, out.faces, out.path)
+    left, right = cut.sides[0]
+    length = np.linalg.norm(np.diff(out.uv[out.path], axis=0), axis=1).sum()
+    assert length < 1.05 * np.linalg.norm(out.uv[out.path[-1]] - out.uv[out.path[0]])  # straight but for snapping
+    for side in (left, right):
+        assert np.array_equal(cut.source[side], out.path)
+        assert np.linalg.norm(np.diff(cut.vertices[side], axis=0), axis=1).sum() == pytest.approx(length, rel=1e-12)
+    # The input is never changed.
+    assert np.array_equal(v, _grid()[0]) and np.array_equal(f, _grid()[1])
+
+
+def test_several_paths_are_cut_at_once():
+    v, f = _grid(6)
+    a = np.array([1, 8, 15])  # two columns of vertices up from the bottom edge
+
+    b = np.array([4, 11, 18])
+    cut = cut_along(v, f, [a, b])
+    assert len(cut.sides) == 2
+    assert len(cut.vertices) == len(v) + (len(a) - 1) + (len(b) - 1)
+    assert len(validate_mesh(cut.vertices, cut.faces)[2].loops) == 1

@@ -67,15 +67,21 @@ def run(module: str, tests: list, python: Path) -> dict:
         config = (f'\n[tool.mutmut]\nsource_paths = ["patterns"]\nonly_mutate = ["{module}"]\n'
                   f"pytest_add_cli_args_test_selection = {tests!r}\nmutate_only_covered_lines = true\n"
                   f"pytest_add_cli_args = {['-k', SKIP]!r}\n"
-                  'also_copy = ["samples/"]\n').replace("'", '"')
+                  'also_copy = ["samples/", "docs/"]\n').replace("'", '"')
         with open(work / "pyproject.toml", "a") as fh:
             fh.write(config)
         mutmut = [str(python), "-m", "mutmut"]
-        subprocess.run([*mutmut, "run"], cwd=work, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        done = subprocess.run([*mutmut, "run"], cwd=work, capture_output=True, text=True)
         listing = subprocess.run([*mutmut, "results", "--all", "true"], cwd=work, capture_output=True,
                                  text=True).stdout
+        diffs = {name: subprocess.run([*mutmut, "show", name], cwd=work, capture_output=True, text=True).stdout
+                 for name, state in re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M)
+                 if state.strip() == "survived"}
     status = re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M)
-    out = {"killed": 0, "survived": 0, "timeout": 0, "other": 0, "survivors": []}
+    if not status or all(state.strip() not in ("killed", "survived", "timeout") for _, state in status):
+        # mutmut stopped before mutating (its clean run of the tests failed, say): show why
+        raise SystemExit(f"mutmut made no mutants of {module}:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
+    out = {"killed": 0, "survived": 0, "timeout": 0, "other": 0, "survivors": [], "diffs": diffs}
     for name, state in status:
         key = {"killed": "killed", "survived": "survived", "timeout": "timeout"}.get(state.strip(), "other")
         out[key] += 1
@@ -101,7 +107,7 @@ def main(argv=None) -> int:
         rows.append(f"| `{module}` | {killed + r['survived']} | {killed} | {r['survived']} | {score:.1%} |")
         print(rows[-1], flush=True)
         for name in r["survivors"]:
-            print(f"survived: {name}", file=sys.stderr, flush=True)
+            print(f"survived: {name}\n{r['diffs'].get(name, '')}", file=sys.stderr, flush=True)
     print(f"| all | {total_k + total_s} | {total_k} | {total_s} | {total_k / max(total_k + total_s, 1):.1%} |")
     return 0
 

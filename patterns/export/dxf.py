@@ -148,13 +148,14 @@ MACHINE_LAYERS = {
     "NOTCH": 6,  # magenta: notch marks at seam ends
     "GRAIN": 3,  # green: grain line
     "BEND": 2,  # yellow: bend and ruling lines (sheet metal)
+    "DRILL": 4,  # cyan: drill holes (POINT), at dart tips
     "LABEL": 7,  # white/black: every text
     "STRAIN": 8,  # grey: optional strain heat map (filled triangles)
 }
 """Layers of the machine profile and their colours (AutoCAD colour index)."""
 
 ASTM_LAYERS = {1: "cut line, piece text", 2: "turn points", 3: "curve points", 4: "notches", 7: "grain line",
-               8: "internal lines", 11: "internal cut-outs", 14: "sew line", 15: "annotation"}
+               8: "internal lines", 11: "internal cut-outs", 13: "drill holes", 14: "sew line", 15: "annotation"}
 """Layers of the ASTM D6673 profile."""
 
 
@@ -405,7 +406,48 @@ def _notches(pattern, geo, allowance_of, spacing=None):
                     normal = -normal  # outward = away from the panel
                 depth = allowance_of(seam.id)
                 out.append((point, normal, depth if depth > 0 else 3.0, depth > 0))
+    depth = allowance_of(None)
+    for point, normal in _dart_mouths(pattern.panels[geo.index], geo, across=depth > 0):
+        out.append((point, normal, depth if depth > 0 else 3.0, depth > 0))
     return out
+
+
+def _dart_mouths(flat, geo, *, across: bool) -> list:
+    """``(point, outward direction)`` where each leg of each dart meets the outline.
+
+    ``across`` (a seam allowance is drawn): square to the leg, as at the end
+    of a seam side (the two legs are sewn like one), so that the notch runs
+    from the seam line out across the leg's allowance.  Otherwise the corner
+    where leg and outline meet is a cut line both ways, and the notch is a
+    snip into the piece along the corner's bisector (the direction returned
+    is its opposite: notches without an allowance are drawn inwards).
+    """
+    out = []
+    loops = [np.asarray(loop) for loop in flat.loops]
+    for dart in flat.darts:
+        for leg in dart.legs:
+            mouth = geo.uv[leg[0]]
+            along = geo.uv[leg[1]] - mouth
+            along = along / max(np.linalg.norm(along), 1e-300)
+            if across:
+                normal = np.array([along[1], -along[0]])
+            else:
+                (loop,) = [lp for lp in loops if np.any(lp == leg[0])]
+                at = int(np.flatnonzero(loop == leg[0])[0])
+                nbrs = [int(loop[at - 1]), int(loop[(at + 1) % len(loop)])]
+                rim = geo.uv[nbrs[1] if nbrs[0] == leg[1] else nbrs[0]] - mouth
+                normal = -(along + rim / max(np.linalg.norm(rim), 1e-300))
+                normal = normal / max(np.linalg.norm(normal), 1e-300)
+            probe = mouth + 0.25 * float(np.linalg.norm(geo.uv[leg[1]] - mouth)) * normal
+            if shapely.contains_xy(geo.polygon, *probe):
+                normal = -normal  # outward = away from the piece
+            out.append((mouth, normal))
+    return out
+
+
+def _drill_holes(flat, geo) -> np.ndarray:
+    """(d, 2) float64, mm, placed: the tip of each dart (a drill hole marks it, on the DRILL layer or ASTM 13)."""
+    return np.array([geo.uv[dart.tip] for dart in flat.darts]).reshape(-1, 2)
 
 
 def write_pattern_dxf(pattern, path, options: DxfOptions | None = None, **keywords) -> None:
@@ -500,6 +542,8 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
                 for arm in (side, -side):
                     msp.add_line(tuple(point * scale), tuple((point + direction * depth + arm) * scale),
                                  dxfattribs={"layer": "NOTCH"})
+        for tip in _drill_holes(pattern.panels[g.index], g):
+            msp.add_point(tuple(tip * scale), dxfattribs={"layer": "DRILL"})
         a, b = _grain_line(g)
         msp.add_line(tuple(np.asarray(a) * scale), tuple(np.asarray(b) * scale), dxfattribs={"layer": "GRAIN"})
         text(g.name, g.label_at + [0.0, 0.8 * g.text_height], 1.2 * g.text_height)
@@ -625,6 +669,8 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
             if notch_style == "v":
                 attribs["thickness"] = float(depth)
             block.add_point((float(base[0]), float(base[1]), float(depth)), dxfattribs=attribs)
+        for tip in _drill_holes(pattern.panels[g.index], g):
+            block.add_point((float(tip[0]), float(tip[1])), dxfattribs={"layer": "13"})
         block.add_line(*_grain_line(g), dxfattribs={"layer": "7"})
         if bend_spacing is not None:  # internal lines (layer 8): the rulings of a rolled panel
             for a, b, _ in pattern.panels[g.index].rulings(bend_spacing):

@@ -18,6 +18,7 @@ from ..pattern import FlatPanel, FlatSeam, Flattening, Pattern
 from .darts import cut_darts
 from .develop import developed, neutral_offset, offset_along_normals
 from .engine import flatten_mesh
+from .gores import gored
 from .grain import grain_table, turn_to_grain
 from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
 from .settings import FlattenOptions
@@ -55,10 +56,11 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
           least-strain lengths;
         * ``ease``: :class:`~patterns.Ease` entries, deliberate extra (or less)
           length on one side of a seam;
-        * ``max_strain``, ``max_darts`` (60): a freeform panel above the strain
-          is cut, one dart at a time, from the outline to its most strained
-          point (:mod:`patterns.flattening.darts`), until within the limit or
-          ``max_darts`` cuts; every cut is in :attr:`FlatPanel.darts`;
+        * ``max_strain``, ``max_darts`` (12): a freeform panel whose worst
+          triangle is above the strain gets the fewest evenly spaced darts
+          (at most ``max_darts``), each as short as the limit allows, their
+          legs sewn to equal length (:mod:`patterns.flattening.darts`); they
+          are in :attr:`FlatPanel.darts`;
         * ``max_iterations`` (500), ``energy_tolerance`` (1e-6; ``flatten_mesh``:
           1e-5, a pattern is relaxed to convergence), ``min_stretch``,
           ``energy`` (``"auto"``): the relaxation, see :func:`flatten_mesh`.
@@ -84,9 +86,14 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     opts = FlattenOptions.of(options, keywords, name=model.name)
     method, max_strain, max_darts = opts.method, opts.max_strain, opts.max_darts
     offset = neutral_offset(opts.thickness, opts.k_factor, opts.reference, name=model.name)
+    grain_table(opts.grain, model)  # bad grain or ease refused before any long work
+    eased = validate_ease(opts.ease, model)
+    if max_strain is not None and opts.gores:
+        keep = {model.seams[s].panels[side] for s, side in eased}  # an eased seam's panel keeps its name
+        model = _split_into_gores(model, opts, offset, keep)
+        eased = validate_ease(opts.ease, model)
     grains = grain_table(opts.grain, model)
     mode = SeamLengths(opts.seams)
-    eased = validate_ease(opts.ease, model)
     eased_panels = {model.seams[s].panels[side] for s, side in eased}
     flat, targets = [], {}
     for i, panel in enumerate(model.panels):
@@ -103,7 +110,7 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
                            energy_tolerance=opts.energy_tolerance, min_stretch=opts.min_stretch, energy=opts.energy,
                            name=name)
             result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
-            if max_strain is not None:
+            if max_strain is not None and not opts.gores:
                 result, darts = cut_darts(result, max_strain, max_darts, held, options)
         targets.update(_side_targets(model, i, result, eased, mode))
         if panel.name in grains:
@@ -120,6 +127,26 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     return Pattern(model=model, panels=tuple(flat), seams=tuple(seams_out), method=method,
                    thickness=opts.thickness, k_factor=opts.k_factor, reference=opts.reference,
                    max_strain=opts.max_strain)
+
+
+def _split_into_gores(model: Model, opts: FlattenOptions, offset: float, keep: set) -> Model:
+    """``gores=True``: every freeform panel above the strain limit split into gores (:mod:`.gores`).
+
+    Panels are taken last to first, so that a split does not move the
+    panels still to be looked at.
+    """
+    for i in reversed(range(len(model.panels))):
+        panel = model.panels[i]
+        if (opts.exact and panel.surface is not None) or opts.method != "relaxed" or i in keep:
+            continue
+        name = f"{model.name}: panel {panel.name}"
+        vertices = offset_along_normals(panel, offset) if offset else panel.vertices
+        held = held_lengths(model, i, vertices, {}, SeamLengths(opts.seams), mesh_edges=unique_edges(panel.faces))
+        options = dict(method=opts.method, max_iterations=opts.max_iterations, energy_tolerance=opts.energy_tolerance,
+                       min_stretch=opts.min_stretch, energy=opts.energy, name=name)
+        result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
+        model = gored(model, i, result, opts.max_strain, opts.max_darts, options)
+    return model
 
 
 def _flat_length(result: Flattening, edges: np.ndarray, idx) -> float:

@@ -98,10 +98,15 @@ class FlattenOptions(Options):
     ease: tuple | None = option(None, "deliberate extra length on one side of a seam (patterns.Ease; on the command "
                                 "line SEAM:PANEL:MM or SEAM:PANEL:PERCENT%, repeatable)",
                           check=_ease, parse=parse_ease, repeat=True, metavar="SEAM:PANEL:AMOUNT")
-    max_strain: float | None = option(None, "cut darts into a freeform panel whose triangle strain is above this "
-                                            "ratio (0.03 = 3 %), one at a time, up to max_darts",
+    max_strain: float | None = option(None, "cut darts into a freeform panel whose worst triangle strain is "
+                                            "above this ratio (0.03 = 3 %): the fewest evenly spaced darts, as short "
+                                            "as the limit allows",
                                       low=0, low_open=True, optional=True, flag="--dart-strain", metavar="R")
-    max_darts: int = option(60, "at most this many darts per panel", low=0, integer=True, metavar="N")
+    max_darts: int = option(12, "at most this many darts per panel (with gores: cuts)", low=0, integer=True,
+                            metavar="N")
+    gores: bool = option(False, "with a strain limit: split a panel above it into gores along the dart lines, "
+                                "run on to the crown, each cut a seam held at its 3D length, instead of darts "
+                                "that stop short")
     max_iterations: int = option(500, "relaxed: at most this many relaxation iterations", low=0, low_open=True,
                                  integer=True, metavar="N")
     energy_tolerance: float = option(1e-6, "relaxed: stop when the energy falls by less than this fraction per "

@@ -1,0 +1,96 @@
+"""Darts at a strain limit: how many, how long against the gore bound, how strained, how fast (issue 18).
+
+For each dome: the worst triangle strain without darts, then with
+``flatten(max_strain=...)``: darts, worst triangle and RMS strain (area-weighted
+principal strains), the darts' total 3D length against the gore bound of a
+sphere of the same radius (docs/garments.md: a gore ``4 sqrt(limit)`` rad
+wide, each running a quarter meridian), the largest difference between a
+dart's two legs, and the time as a ratio to peers run side by side on the same
+mesh: our own dartless flattening and libigl's ARAP (``bench_flatten.igl_arap``,
+a single-panel flattening with no limit; there is no open dart tool to race).
+
+* ``hemisphere``: one build123d spherical face, R 150 mm, as ``patterns.load``
+  meshes it (4,924 triangles);
+* ``hemisphere 10k``: ``surfaces.spherical_cap`` at R 150 mm, 10k triangles;
+* ``cup``: ``samples/cup.step``, four quarter-sphere gores of R 100 mm;
+* ``four gores``: the R 150 hemisphere cut into four quarter gores in build123d.
+
+    python benchmarks/darts.py [--limit 0.03]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from functools import partial
+from pathlib import Path
+
+import build123d as bd
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_flatten as bench  # libigl's ARAP, as the flattening benchmark runs it
+
+import patterns
+from patterns import surfaces
+from patterns.measure import strain_rms, triangle_strains
+from patterns.reading import mesh_model
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def domes():
+    """``(name, model, sphere radius mm)``."""
+    half = bd.Sphere(150.0, arc_size1=0)
+    (face,) = [f for f in half.faces() if f.geom_type != bd.GeomType.PLANE]
+    quarters = [half & bd.Pos(sx * 200, sy * 200, 0) * bd.Box(400, 400, 400) for sx in (1, -1) for sy in (1, -1)]
+    gores = [f for q in quarters for f in q.faces() if f.geom_type != bd.GeomType.PLANE]
+    v, f = surfaces.spherical_cap(radius=150.0, half_angle=90.0, n_faces=10_000)
+    return [("hemisphere", patterns.load(face), 150.0),
+            ("hemisphere 10k", mesh_model(v, f, name="hemisphere 10k"), 150.0),
+            ("cup", patterns.load(REPO / "samples" / "cup.step"), 100.0),
+            ("four gores", patterns.load(bd.Compound(gores)), 150.0)]
+
+
+def gore_bound(radius: float, limit: float, share: float = 1.0) -> float:
+    """Total gore-seam length a sphere's dome needs at ``limit`` (``share`` of a full hemisphere)."""
+    return share * 2 * np.pi / (4 * np.sqrt(limit)) * np.pi * radius / 2
+
+
+def timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return out, time.perf_counter() - t0
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--limit", type=float, default=0.03)
+    limit = parser.parse_args(argv).limit
+    print(f"strain limit {limit:.1%}\n")
+    print("| dome | triangles | worst, no darts | darts | worst | RMS | dart length / gore bound "
+          "| legs differ by | time | / dartless | / libigl ARAP |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name, model, radius in domes():
+        plain, t_plain = timed(partial(patterns.flatten, model))
+        darted, t_darts = timed(partial(patterns.flatten, model, max_strain=limit))
+        t_igl = sum(timed(partial(bench.igl_arap, panel.vertices, panel.faces))[1] for panel in model.panels)
+        before = max(triangle_strains(p.vertices, p.faces, p.uv).magnitude.max() for p in plain.panels)
+        after = max(triangle_strains(p.vertices, p.faces, p.uv).magnitude.max() for p in darted.panels)
+        rms = max(strain_rms(p.vertices, p.faces, p.uv) for p in darted.panels)
+        darts = [d for p in darted.panels for d in p.darts]
+        length = sum(d.length_3d for d in darts)
+        legs = max((abs(np.subtract(*d.leg_lengths(p.uv))) for p in darted.panels for d in p.darts), default=0.0)
+        area = sum(p.area for p in model.panels)
+        share = area / (2 * np.pi * radius**2)  # of a hemisphere's area
+        n = sum(len(p.faces) for p in model.panels)
+        print(f"| {name} | {n:,} | {before:.1%} | {len(darts)} | {after:.2%} | {rms:.2%} "
+              f"| {length:,.0f} / {gore_bound(radius, limit, share):,.0f} mm "
+              f"({length / gore_bound(radius, limit, share):.2f}) | {legs:.3f} mm | {t_darts:.1f} s "
+              f"| {t_darts / t_plain:.0f} x | {t_darts / t_igl:.0f} x |", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

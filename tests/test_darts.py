@@ -1,0 +1,234 @@
+"""Darts a pattern maker would cut: few, long, evenly spaced, within the strain limit, legs that sew (issue 18)."""
+
+import json
+import subprocess
+
+import build123d as bd
+import ezdxf
+import numpy as np
+import pytest
+import shapely
+
+import patterns
+from patterns.measure import triangle_strains
+
+from .conftest import SAMPLES
+
+LIMIT = 0.03
+R = 150.0
+
+
+def gore_bound(radius: float, limit: float) -> float:
+    """Total length of the gore seams a hemisphere needs at a strain limit (docs/garments.md).
+
+    A strip of half-width w about a geodesic of a sphere, flattened with its
+    lengths balanced, strains about w**2 / (4 R**2): at ``limit`` a gore is
+    4 sqrt(limit) radians wide at the rim, and 2 pi over that many gores each
+    run a quarter meridian, pi R / 2, from the rim to the pole.
+    """
+    gores = 2 * np.pi / (4 * np.sqrt(limit))
+    return gores * np.pi * radius / 2
+
+
+def worst(flat) -> float:
+    return float(triangle_strains(flat.vertices, flat.faces, flat.uv).magnitude.max())
+
+
+def leg_lengths(flat, dart):
+    """Each leg's flat length, measured here from the leg's points."""
+    return [float(np.linalg.norm(np.diff(flat.uv[leg], axis=0), axis=1).sum()) for leg in dart.legs]
+
+
+@pytest.fixture(scope="module")
+def hemisphere():
+    solid = bd.Sphere(R, arc_size1=0)  # the upper half: a spherical face and the disk closing it
+    (face,) = [f for f in solid.faces() if f.geom_type != bd.GeomType.PLANE]
+    model = patterns.load(face)
+    return model, patterns.flatten(model, max_strain=LIMIT)
+
+
+def test_a_hemisphere_gets_a_few_long_darts_within_the_limit(hemisphere):
+    model, pattern = hemisphere
+    (flat,) = pattern.panels
+    assert worst(patterns.flatten(model).panels[0]) > 0.3  # measured 38.7 % without darts
+    assert worst(flat) <= LIMIT
+    assert 1 <= len(flat.darts) <= 12
+    assert flat.flattening.one_to_one and flat.flattening.n_folded == 0
+    # The darts' total length on the sphere, measured here along each cut's points,
+    # within 1.3 x the gore bound (2,137 mm at R 150 and 3 %).
+    total = sum(np.linalg.norm(np.diff(flat.vertices[d.path], axis=0), axis=1).sum() for d in flat.darts)
+    assert total == pytest.approx(sum(d.length_3d for d in flat.darts), rel=1e-12)
+    assert total <= 1.3 * gore_bound(R, LIMIT)
+    # Each dart runs from the rim most of the way to the pole: long, not nicks at the rim
+    # (build123d centres the half sphere's box: the rim at z = -R/2, the pole at z = R/2).
+    rim = flat.vertices[:, 2].min()
+    assert rim == pytest.approx(-R / 2, abs=1e-6)
+    for dart in flat.darts:
+        start, tip = flat.vertices[dart.path[0]], flat.vertices[dart.path[-1]]
+        assert start[2] - rim < 1e-6 and tip[2] - rim > 0.8 * R
+    # Evenly spaced round the rim.
+    angles = np.sort([np.arctan2(*flat.vertices[d.path[0]][1::-1]) for d in flat.darts])
+    gaps = np.diff(np.r_[angles, angles[0] + 2 * np.pi])
+    assert gaps.max() < 1.25 * gaps.min()
+    # The two legs of every dart sew together: equal flat lengths, to 0.1 mm.
+    for dart in flat.darts:
+        a, b = leg_lengths(flat, dart)
+        assert abs(a - b) < 0.1
+        assert dart.leg_lengths(flat.uv) == pytest.approx((a, b), rel=1e-12)
+    # The limit travels with the pattern: check() judges against it, and says ok.
+    report = patterns.check(pattern)
+    assert report.max_strain == LIMIT and report.ok
+    assert report.panels[0].strain_max == pytest.approx(worst(flat), rel=1e-9)
+
+
+def test_the_report_and_the_dxf_list_every_dart(hemisphere, tmp_path):
+    _, pattern = hemisphere
+    (flat,) = pattern.panels
+    report = patterns.check(pattern)
+    darts = report.panels[0].darts
+    assert len(darts) == len(flat.darts)
+    for row, dart in zip(darts, flat.darts):
+        assert row.length_3d == pytest.approx(np.linalg.norm(np.diff(flat.vertices[dart.path], axis=0), axis=1).sum())
+        assert row.legs_flat == pytest.approx(leg_lengths(flat, dart))
+        assert row.tip == pytest.approx(tuple(flat.uv[dart.tip]))
+    report.to_json(tmp_path / "report.json")
+    doc = json.loads((tmp_path / "report.json").read_text())
+    assert doc["schema"] == "patterns.report/3"
+    assert [d["legs_flat"] for d in doc["panels"][0]["darts"]] == [list(d.legs_flat) for d in darts]
+    assert [d["tip"] for d in doc["panels"][0]["darts"]] == [list(d.tip) for d in darts]
+    (note,) = [f for f in report.findings if f.code is patterns.Code.DARTS]
+    assert len(note.points) == len(flat.darts)
+    # The DXF, read back: a drill hole (POINT on DRILL) at every tip, a notch where every leg meets
+    # the outline, the cut line running into each dart.
+    path = tmp_path / "hemisphere.dxf"
+    pattern.to_dxf(path)
+    msp = ezdxf.readfile(path).modelspace()
+    shift = np.array(msp.query('LWPOLYLINE[layer=="CUT"]')[0].get_points("xy")[0]) - flat.uv[flat.loops[0][0]]
+    drills = np.array([tuple(p.dxf.location)[:2] for p in msp.query('POINT[layer=="DRILL"]')])
+    tips = np.array([flat.uv[d.tip] for d in flat.darts]) + shift
+    assert len(drills) == len(tips)
+    assert np.abs(np.sort(drills, axis=0) - np.sort(tips, axis=0)).max() < 1e-6
+    for allowance in (0.0, 10.0):
+        pattern.to_dxf(path, seam_allowance=allowance)
+        msp = ezdxf.readfile(path).modelspace()
+        ends = [(np.array(tuple(line.dxf.start)[:2]), np.array(tuple(line.dxf.end)[:2]))
+                for line in msp.query('LINE[layer=="NOTCH"]')]
+        cut = shapely.Polygon(msp.query('LWPOLYLINE[layer=="CUT"]')[0].get_points("xy"))
+        sew = shapely.Polygon(msp.query('LWPOLYLINE[layer=="SEW"]')[0].get_points("xy")) if allowance else cut
+        shift = np.array(sew.exterior.coords[0]) - flat.uv[flat.loops[0][0]]
+        for dart in flat.darts:
+            for leg in dart.legs:
+                mouth = flat.uv[leg[0]] + shift
+                (slit,) = [(a, b) for a, b in ends if np.linalg.norm(a - mouth) < 1e-6]
+                along = flat.uv[leg[1]] - flat.uv[leg[0]]
+                if allowance:  # square to the leg, from the seam line out across its allowance
+                    assert abs(np.dot(slit[1] - slit[0], along)) < 1e-6 * np.linalg.norm(along)
+                    assert not sew.contains(shapely.Point(slit[1]))
+                    assert np.linalg.norm(slit[1] - slit[0]) == pytest.approx(allowance)
+                else:  # a 3 mm snip into the piece at the corner: inside it, off both cut lines
+                    tip = shapely.Point(slit[1])
+                    assert cut.contains(tip) and cut.exterior.distance(tip) > 1.0
+                    assert np.linalg.norm(slit[1] - slit[0]) == pytest.approx(3)
+        assert len(sew.exterior.coords) - 1 == len(flat.loops[0])  # the seam line runs into every dart
+    # ASTM: the drill holes on layer 13.
+    astm = tmp_path / "hemisphere_astm.dxf"
+    pattern.to_dxf(astm, profile="astm")
+    doc = ezdxf.readfile(astm)
+    points = [e for b in doc.blocks for e in b if e.dxftype() == "POINT" and e.dxf.layer == "13"]
+    assert len(points) == len(flat.darts)
+
+
+@pytest.mark.parametrize("source", ["cup", "four gores"])
+def test_every_panel_of_a_dome_in_gores_meets_the_limit_and_its_seams_stay_true(source):
+    if source == "cup":
+        model = patterns.load(SAMPLES / "cup.step")
+    else:  # a hemisphere R 150 in four quarter gores (build123d), four seams
+        solid = bd.Sphere(R, arc_size1=0)
+        quarters = [solid & bd.Pos(sx * 200, sy * 200, 0) * bd.Box(400, 400, 400) for sx in (1, -1) for sy in (1, -1)]
+        faces = [f for q in quarters for f in q.faces() if f.geom_type != bd.GeomType.PLANE]
+        model = patterns.load(bd.Compound(faces))
+        assert len(model.panels) == 4 and len(model.seams) == 4
+    pattern = patterns.flatten(model, max_strain=LIMIT)
+    for flat in pattern.panels:
+        assert worst(flat) <= LIMIT
+        assert flat.darts and flat.flattening.one_to_one
+        for dart in flat.darts:
+            a, b = leg_lengths(flat, dart)
+            assert abs(a - b) < 0.1
+    # The darts cut no seam: every seam side is as long flat as its 3D polyline (measured here
+    # from the panels' points), both sides alike.
+    for fs in pattern.seams:
+        length_3d = np.linalg.norm(np.diff(fs.seam.points, axis=0), axis=1).sum()
+        for side, p in enumerate(fs.seam.panels):
+            uv = pattern.panels[p].uv[np.asarray(fs.seam.vertices[side])]
+            assert np.linalg.norm(np.diff(uv, axis=0), axis=1).sum() == pytest.approx(length_3d, abs=0.01)
+    assert patterns.check(pattern).ok
+
+
+def test_a_looser_limit_takes_fewer_darts_and_too_few_darts_are_reported(hemisphere):
+    model, pattern = hemisphere
+    loose = patterns.flatten(model, max_strain=0.06)
+    assert len(loose.panels[0].darts) < len(pattern.panels[0].darts)
+    assert worst(loose.panels[0]) <= 0.06
+    two = patterns.flatten(model, max_strain=LIMIT, max_darts=2)
+    (flat,) = two.panels
+    assert len(flat.darts) <= 2
+    report = patterns.check(two)
+    assert not report.ok
+    assert any(f.code is patterns.Code.STRAIN_ABOVE_LIMIT for f in report.findings)
+
+
+@pytest.mark.parametrize("source, cuts", [("hemisphere", 16), ("cup", 12)])
+def test_gores_split_a_dome_into_pieces_that_each_meet_the_limit(hemisphere, source, cuts, tmp_path):
+    model = hemisphere[0] if source == "hemisphere" else patterns.load(SAMPLES / "cup.step")
+    pattern = patterns.flatten(model, max_strain=LIMIT, gores=True, max_darts=cuts)
+    gores = pattern.model
+    assert len(gores.panels) > len(model.panels)
+    # Nothing lost or doubled: the pieces cover the panels' 3D area exactly.
+    assert sum(p.area for p in gores.panels) == pytest.approx(sum(p.area for p in model.panels), rel=1e-9)
+    for flat in pattern.panels:
+        assert worst(flat) <= LIMIT and flat.flattening.one_to_one and not flat.darts
+    # Every cut is a seam of the model, held true like the others: each side as long flat
+    # as the cut is in 3D (measured here), to 0.01 mm.
+    new = gores.seams[len(model.seams):]
+    assert len(new) >= len(gores.panels) - len(model.panels)
+    for fs in pattern.seams:
+        length_3d = np.linalg.norm(np.diff(fs.seam.points, axis=0), axis=1).sum()
+        for side, p in enumerate(fs.seam.panels):
+            uv = pattern.panels[p].uv[np.asarray(fs.seam.vertices[side])]
+            assert np.linalg.norm(np.diff(uv, axis=0), axis=1).sum() == pytest.approx(length_3d, abs=0.01)
+    assert patterns.check(pattern).ok
+    if source == "hemisphere":  # 13 gores: held at 3D length, a gore may be 2 sqrt(2 x 3 %) rad wide
+        assert len(gores.panels) == int(np.ceil(2 * np.pi / (2 * np.sqrt(2 * LIMIT))))
+    # The DXF: one cut contour per piece.
+    pattern.to_dxf(tmp_path / "gores.dxf")
+    msp = ezdxf.readfile(tmp_path / "gores.dxf").modelspace()
+    assert len(msp.query('LWPOLYLINE[layer=="CUT"]')) == len(gores.panels)
+
+
+@pytest.fixture(scope="module")
+def cup_darts():
+    return patterns.flatten(patterns.load(SAMPLES / "cup.step"), max_strain=LIMIT)
+
+
+def test_real_readers_read_the_darted_pattern(cup_darts, tmp_path):
+    """dxf2gcode chains one closed contour per panel (the outline running into every dart),
+    FreeCAD the same closed wires, each with the outline's own area and length."""
+    from .test_dxf_pattern import READERS, _need, _qt_env, ring_numbers
+
+    path = tmp_path / "cup_darts.dxf"
+    cup_darts.to_dxf(path, version="R2000")
+    _need("dxf2gcode")
+    proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
+                          capture_output=True, text=True, env=_qt_env(tmp_path), timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    found = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert found["entities"]["CUT"] == {"contours": len(cup_darts.panels), "closed": len(cup_darts.panels)}
+    _need("freecadcmd")
+    proc = subprocess.run(["freecadcmd", str(READERS / "freecad_layers.py")], capture_output=True, text=True,
+                          env=dict(_qt_env(tmp_path), DXF=str(path)), timeout=300)
+    lines = [x for x in proc.stdout.splitlines() if "RESULT " in x]
+    assert lines, proc.stdout[-2000:] + proc.stderr[-2000:]
+    wires = json.loads(lines[-1].split("RESULT ", 1)[1])["CUT"]["closed_wires"]
+    expected = sorted(ring_numbers(flat.uv[loop]) for flat in cup_darts.panels for loop in flat.loops)
+    np.testing.assert_allclose(sorted((w["area"], w["length"]) for w in wires), expected, rtol=1e-6)
