@@ -404,17 +404,17 @@ class Pattern:
 
         write_pattern_dxf(self, path, options, **keywords)
 
-    def layout(self, *, width: float, gap: float = 10.0, margin: float = 0.0, allow_rotation: bool = True,
-               respect_grain: bool = True, step: float | None = None):
-        """Nest the panels on a roll ``width`` mm wide; see :func:`patterns.nesting.layout`.
+    def layout(self, *, width: float, **options):
+        """Nest the panels on a roll ``width`` mm wide; the options (``gap``,
+        ``margin``, ``allow_rotation``, ``respect_grain``, ``step``) and their
+        defaults are those of :func:`patterns.nesting.layout`.
 
         Returns a :class:`patterns.nesting.Layout`: ``.pattern`` (laid out),
         ``.length`` used, ``.efficiency``.
         """
         from .nesting import layout
 
-        return layout(self, width=width, gap=gap, margin=margin, allow_rotation=allow_rotation,
-                      respect_grain=respect_grain, step=step)
+        return layout(self, width=width, **options)
 
     def heat_map(self, path, **options) -> None:
         """Write the strain heat map (PNG or SVG); see :func:`patterns.heat_map`."""

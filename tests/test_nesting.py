@@ -104,7 +104,63 @@ def test_the_margin_is_kept_around_each_outline():
                                                ({"width": 100.0, "margin": -1.0}, "margin"),
                                                ({"width": 100.0, "step": 0.0}, "step")])
 def test_bad_layout_options(plates, kwargs, words):
+    """One line naming the pattern and the option."""
     from patterns.errors import InputError
 
-    with pytest.raises(InputError, match=words):
+    with pytest.raises(InputError, match=rf"^{plates.name}: {words} \(mm\) must"):
         plates.layout(**kwargs)
+
+
+def test_small_numbers_are_options_not_errors(plates):
+    """Sub-millimetre widths and gaps are numbers like any other: a 0.5 mm roll is too narrow
+    for the panels (a LayoutError), a 0.5 mm gap is kept."""
+    from patterns.errors import InputError
+
+    with pytest.raises(LayoutError, match="wider than"):
+        plates.layout(width=0.5)
+    nest = plates.layout(width=450.0, gap=0.5)
+    polys = _outlines(nest.pattern)
+    assert min(polys[i].distance(polys[j]) for i in range(len(polys)) for j in range(i + 1, len(polys))) >= 0.5 - 1e-6
+    with pytest.raises(InputError, match="layout\\(\\) takes a patterns.Pattern"):
+        patterns.layout(type("Almost", (), {"panels": (), "name": "x"})(), width=100.0)
+
+
+def test_the_orientations_tried():
+    from patterns.nesting import _orientations
+
+    assert _orientations(True, True) == [0.0, np.pi]  # grain kept: turned end for end at most
+    assert _orientations(False, True) == [0.0] and _orientations(False, False) == [0.0]
+    assert _orientations(True, False) == [0.0, 0.5 * np.pi, np.pi, 1.5 * np.pi]
+
+
+def test_the_defaults_are_those_documented(plates):
+    """gap 10 mm, no margin, rotation allowed, grain kept: the same marker as asked for in full."""
+    default = patterns.layout(plates, width=450.0)  # the function's own defaults
+    explicit = plates.layout(width=450.0, gap=10.0, margin=0.0, allow_rotation=True, respect_grain=True)
+    assert [f.placement for f in default.pattern.panels] == [f.placement for f in explicit.pattern.panels]
+    assert default.width == 450.0 and default.length == explicit.length
+    for other in ({"gap": 11.0}, {"margin": 1.0}, {"respect_grain": False}):
+        changed = plates.layout(width=450.0, **other)
+        assert [f.placement for f in changed.pattern.panels] != [f.placement for f in default.pattern.panels]
+
+
+def test_a_panel_laid_askew_is_squared_up_and_placed_where_its_outline_is():
+    """Without the grain, a rectangle drawn at 30 degrees is turned square to the roll first: the
+    placed outline, read from the placed panel, is axis-aligned, inside the roll, and the length is
+    its top."""
+    from patterns.reading import mesh_model
+
+    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+    x, y = np.meshgrid(np.linspace(0, 120, 7), np.linspace(0, 40, 3))
+    pts = np.column_stack([x.ravel(), y.ravel()]) @ np.array([[c, s], [-s, c]])
+    quads = [(r * 7 + k, r * 7 + k + 1, (r + 1) * 7 + k + 1, (r + 1) * 7 + k) for r in range(2) for k in range(6)]
+    tri = np.array([t for a, b, cc, d in quads for t in ((a, b, cc), (a, cc, d))])
+    pattern = patterns.flatten(mesh_model(np.column_stack([pts, np.zeros(len(pts))]), tri, name="askew"),
+                               method="isometric")
+    nest = pattern.layout(width=200.0, respect_grain=False, allow_rotation=False)
+    (poly,) = _outlines(nest.pattern)
+    x0, y0, x1, y1 = poly.bounds
+    assert poly.area == pytest.approx(120 * 40, rel=1e-9)
+    assert (x1 - x0) * (y1 - y0) == pytest.approx(120 * 40, rel=1e-6)  # squared up: its box is itself
+    assert x0 >= -1e-6 and x1 <= 200.0 + 1e-6 and y0 >= -1e-6
+    assert nest.length == pytest.approx(y1, abs=1e-6) and nest.width == 200.0
