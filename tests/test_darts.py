@@ -232,3 +232,48 @@ def test_real_readers_read_the_darted_pattern(cup_darts, tmp_path):
     wires = json.loads(lines[-1].split("RESULT ", 1)[1])["CUT"]["closed_wires"]
     expected = sorted(ring_numbers(flat.uv[loop]) for flat in cup_darts.panels for loop in flat.loops)
     np.testing.assert_allclose(sorted((w["area"], w["length"]) for w in wires), expected, rtol=1e-6)
+
+
+def test_dart_lines_start_evenly_on_the_stretched_outline_and_point_inwards(hemisphere):
+    from patterns.flattening.darts import dart_lines
+
+    model, _ = hemisphere
+    plain = patterns.flatten(model).panels[0].flattening
+    loop = plain.loops[0]
+    outline = shapely.Polygon(plain.uv[loop])
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(plain.uv[np.r_[loop, loop[:1]]], axis=0), axis=1))]
+    step = np.diff(arc).max()
+    for k in (1, 4, 9):
+        lines = dart_lines(plain, k, LIMIT)
+        assert len(lines) == k
+        at = np.sort([arc[np.flatnonzero(loop == line.start)[0]] for line in lines])
+        gaps = np.diff(np.r_[at, at[0] + arc[-1]])
+        assert np.abs(gaps - arc[-1] / k).max() <= step  # evenly spaced, to one outline edge
+        for line in lines:
+            assert np.linalg.norm(line.direction) == pytest.approx(1.0)
+            assert outline.contains(shapely.Point(plain.uv[line.start] + 1.0 * line.direction))  # inwards
+            # The flattened hemisphere is nearly round: each line reaches across it, a diameter.
+            assert line.reach == pytest.approx(2 * np.sqrt(outline.area / np.pi), rel=0.1)
+
+
+def test_gore_lines_part_an_open_stretch_into_equal_parts():
+    """On a quarter-sphere gore the rim is the stretch (the seams are held at 3D length): darts sit
+    in the middle of k equal parts of it, gore cuts part it into k + 1."""
+    from patterns.flattening.darts import dart_lines
+
+    flat = patterns.flatten(patterns.load(SAMPLES / "cup.step")).panels[0].flattening
+    loop = np.asarray(flat.loops[0])
+    for split, k, shares in ((False, 2, [0.25, 0.75]), (True, 2, [1 / 3, 2 / 3])):
+        lines = dart_lines(flat, k, LIMIT, split=split)
+        starts = [line.start for line in lines]
+        # Walk the rim: the outline vertices whose neighbours are stretched, in loop order.
+        nxt = np.roll(loop, -1)
+        over = np.linalg.norm(flat.uv[nxt] - flat.uv[loop], axis=1) > np.linalg.norm(
+            flat.vertices[nxt] - flat.vertices[loop], axis=1) * (1 + 0.5 * LIMIT)
+        first = int(np.flatnonzero(~over)[0])
+        order = np.roll(np.arange(len(loop)), -first - 1)
+        rim = [loop[i] for i in order if over[i]] + [loop[(order[over[order]][-1] + 1) % len(loop)]]
+        arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(flat.uv[rim], axis=0), axis=1))]
+        at = sorted(arc[rim.index(s)] / arc[-1] for s in starts)
+        step = np.diff(arc).max() / arc[-1]
+        assert np.abs(np.array(at) - shares).max() <= step

@@ -46,7 +46,7 @@ from ..pattern import Dart, Flattening
 from .engine import flatten_mesh
 from .seams import seam_edges
 
-__all__ = ["cut_darts", "dart_lines"]
+__all__ = ["DartLine", "cut_darts", "dart_lines"]
 
 _TIP_GAP = 4.0  # tips at least this many mean flat edge lengths apart, and from the far outline
 _BISECTIONS = 4  # halvings of the common dart length once a count meets the limit
@@ -54,9 +54,19 @@ _HELD = 1e-3  # a try whose held lengths end further off than this share (a stal
 _STRETCHED = 0.5  # an outline vertex is on a stretch when its flat edges exceed 3D by this share of the limit
 
 
-@dataclass(frozen=True)
-class _Line:
-    """A candidate dart on the dartless layout: from outline vertex ``start`` along ``direction``, ``reach`` mm at most."""
+@dataclass(frozen=True, eq=False)
+class DartLine:
+    """A candidate dart, drawn on the dartless layout.
+
+    Attributes
+    ----------
+    start : int
+        The outline vertex it starts from.
+    direction : (2,) float64
+        Unit direction in the layout: the outline's inward normal there.
+    reach : float
+        Distance along ``direction`` to the far side of the outline, mm.
+    """
 
     start: int
     direction: np.ndarray
@@ -121,7 +131,7 @@ def dart_lines(result: Flattening, k: int, limit: float, *, split: bool = False)
 
     Returns
     -------
-    list of _Line
+    list of DartLine
         Each with its start vertex, unit direction (flat) and reach: the
         distance along the direction to the outline on the far side.
     """
@@ -150,7 +160,7 @@ def dart_lines(result: Flattening, k: int, limit: float, *, split: bool = False)
                 before, after = run[-3], run[2]
             tangent = uv[after] - uv[before]
             inward = np.array([-tangent[1], tangent[0]]) / max(np.linalg.norm(tangent), 1e-300)
-            lines.append(_Line(vertex, inward, _reach(polygon, uv[vertex], inward)))
+            lines.append(DartLine(vertex, inward, _reach(polygon, uv[vertex], inward)))
     return lines
 
 
