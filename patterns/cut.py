@@ -312,7 +312,7 @@ class Inserted:
 
 
 def insert_line(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, start, end, *,
-                snap: float = 0.25, keep_off=None) -> Inserted:
+                snap: float = 0.1, keep_off=None) -> Inserted:
     """Insert the straight line from ``start`` to ``end`` of a layout into the mesh as a path of edges.
 
     A dart is drawn straight on a pattern; cut along the mesh's own edges it
@@ -321,7 +321,11 @@ def insert_line(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, start, 
     (by linear interpolation, in 3D and in the layout: the surface does not
     move), and each crossed triangle is split along the segment.  A vertex
     closer to the segment than ``snap`` times its edges' mean flat length is
-    taken onto the path instead (no sliver triangles).
+    taken onto the path instead (no sliver triangles).  ``snap`` trades the
+    two: at 0.25 a dart's legs jog visibly (measured on the cup: each leg
+    turns 4-8 rad in all, a zigzag), at 0.02 the slivers strain (a hemisphere's
+    worst triangle 11 %), at 0.1 legs turn 1-2 rad and the strain is that of
+    the surface.
 
     Parameters
     ----------

@@ -28,8 +28,6 @@ from .seams import held_lengths
 
 __all__ = ["gored", "split_panel"]
 
-_SNAP = 0.1  # insert_line's snap: the lines converge on the crown, where a quarter edge is too coarse
-
 
 def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, options: dict) -> Model:
     """The model with panel ``index`` split into the fewest gores that each flatten within ``limit``.
@@ -168,7 +166,7 @@ def _gore_paths(result: Flattening, k: int, limit: float):
     v, f, p = result.vertices, result.faces, uv
     paths, taken = [], []
     for line in lines:
-        inserted = insert_line(v, f, p, uv[line.start], uv[crown], snap=_SNAP, keep_off=taken)
+        inserted = insert_line(v, f, p, uv[line.start], uv[crown], keep_off=taken)
         v, f, p = inserted.vertices, inserted.faces, inserted.uv
         if inserted.path[0] != line.start or inserted.path[-1] != crown:
             return None
