@@ -76,25 +76,49 @@ def test_offsetting_a_cylinder_moves_points_radially():
     np.testing.assert_allclose(moved[:, 2], pts[:, 2], atol=1e-12)
 
 
-def test_a_general_cone_unrolls_by_its_directrix():
+@pytest.mark.parametrize(("apex", "samples", "tol"), [((0.0, 0.0, 0.0), None, 1e-7),
+                                                     ((30.0, -20.0, 50.0), 61, 1e-9)])
+def test_a_general_cone_unrolls_by_its_directrix(apex, samples, tol):
     """A right circular cone given as a general cone (apex and a sampled directrix, as a
     square-to-round transition's corner faces are): the same polar development as the analytic
-    cone, between the directrix's samples too."""
+    cone, between the directrix's samples too -- with the apex anywhere, and the directrix
+    sampled unevenly (61 samples at random spacing: each point's angle is interpolated between
+    two unequal steps)."""
     a, height = np.radians(25.0), 200.0
-    u = np.linspace(0.0, 2 * np.pi / 3, 2001)
+    if samples is None:
+        u = np.linspace(0.0, 2 * np.pi / 3, 2001)
+    else:
+        u = np.sort(np.r_[0.0, np.random.default_rng(7).uniform(0.0, 2 * np.pi / 3, samples - 2), 2 * np.pi / 3])
     rim = height * np.tan(a)
-    directrix = np.column_stack([rim * np.cos(u), rim * np.sin(u), np.full(len(u), height)])
-    cone = Surface(kind=SurfaceKind.GENERAL_CONE, origin=np.zeros(3), x_dir=np.zeros(3), y_dir=np.zeros(3),
+    apex = np.asarray(apex)
+    directrix = apex + np.column_stack([rim * np.cos(u), rim * np.sin(u), np.full(len(u), height)])
+    cone = Surface(kind=SurfaceKind.GENERAL_CONE, origin=apex, x_dir=np.zeros(3), y_dir=np.zeros(3),
                    axis=np.zeros(3), directrix=directrix)
     rng = np.random.default_rng(4)
     pu = rng.uniform(0.01, 2 * np.pi / 3 - 0.01, 40)  # between samples
     h = rng.uniform(20.0, 190.0, 40)
-    pts = np.column_stack([h * np.tan(a) * np.cos(pu), h * np.tan(a) * np.sin(pu), h])
-    uv = develop(cone, np.vstack([np.zeros(3), pts]))
+    if samples is not None:  # on the sampled (polyhedral) cone: between two directrix points, linearly
+        k = np.clip(np.searchsorted(u, pu) - 1, 0, len(u) - 2)
+        w = (pu - u[k]) / (u[k + 1] - u[k])
+        ring = (1 - w)[:, None] * directrix[k] + w[:, None] * directrix[k + 1] - apex
+        pts = apex + ring * (h / height)[:, None]
+        # Its development, by hand: distance from the apex, and the angle the cone's own sector
+        # gives (the chord angles of the directrix seen from the apex, summed), interpolated by
+        # the angle within the step.
+        d = (directrix - apex) / np.linalg.norm(directrix - apex, axis=1)[:, None]
+        steps = np.arccos(np.clip((d[1:] * d[:-1]).sum(axis=1), -1, 1))
+        theta = np.r_[0.0, np.cumsum(steps)]
+        r = ring / np.linalg.norm(ring, axis=1)[:, None]
+        within = np.arccos(np.clip((r * d[k]).sum(axis=1), -1, 1))
+        expect_s, expect_angle = np.linalg.norm(pts - apex, axis=1), theta[k] + within
+    else:
+        pts = apex + np.column_stack([h * np.tan(a) * np.cos(pu), h * np.tan(a) * np.sin(pu), h])
+        expect_s, expect_angle = h / np.cos(a), pu * np.sin(a)
+    uv = develop(cone, np.vstack([apex, pts]))
     np.testing.assert_allclose(uv[0], 0.0, atol=1e-12)  # the apex
-    s = h / np.cos(a)
-    np.testing.assert_allclose(np.hypot(uv[1:, 0], uv[1:, 1]), s, rtol=1e-12)
-    np.testing.assert_allclose(np.arctan2(uv[1:, 1], uv[1:, 0]), pu * np.sin(a), atol=1e-7)
+    np.testing.assert_allclose(np.hypot(uv[1:, 0], uv[1:, 1]), expect_s, rtol=1e-12)
+    angle = np.arctan2(uv[1:, 1], uv[1:, 0])
+    np.testing.assert_allclose(angle - angle.min(), expect_angle - expect_angle.min(), atol=tol)
 
 
 def test_offsetting_small_triangles_moves_by_the_offset_along_the_normal():

@@ -154,3 +154,20 @@ def test_dominant_strain_direction_is_the_axis_it_acts_along(flat_disk, sx, sy, 
     dist = np.minimum(np.abs(ts.direction - angle), np.pi - np.abs(ts.direction - angle))
     assert np.all(dist < 1e-9)
     assert not ts.direction.flags.writeable and not ts.stretch.flags.writeable
+
+
+def test_folded_means_not_positive_at_any_size():
+    """A flat triangle counts as folded when its signed area is not positive -- zero included
+    (collapsed) -- whatever its size: a mesh of 0.01 mm triangles laid flat unchanged has none."""
+    x, y = np.meshgrid(np.linspace(0.0, 0.05, 6), np.linspace(0.0, 0.05, 6))
+    v = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    k = np.arange(30).reshape(5, 6)[:, :5].ravel()
+    f = np.vstack([np.column_stack([k, k + 1, k + 7]), np.column_stack([k, k + 7, k + 6])])
+    uv = v[:, :2].copy()
+    assert measure.distortion(v, f, uv).n_folded == 0  # triangles of 5e-5 mm^2, all positive
+    collapsed = uv.copy()
+    collapsed[7] = (collapsed[0] + collapsed[1]) / 2  # vertex 7 onto the side 0-1: triangle (0, 1, 7) collapses
+    sa = 0.5 * ((collapsed[f[:, 1]] - collapsed[f[:, 0]])[:, 0] * (collapsed[f[:, 2]] - collapsed[f[:, 0]])[:, 1]
+                - (collapsed[f[:, 1]] - collapsed[f[:, 0]])[:, 1] * (collapsed[f[:, 2]] - collapsed[f[:, 0]])[:, 0])
+    assert np.any(sa == 0.0)
+    assert measure.distortion(v, f, collapsed).n_folded == int(np.count_nonzero(sa <= 0.0))

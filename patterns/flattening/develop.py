@@ -142,7 +142,9 @@ def _develop_general_cone(surface, points: np.ndarray) -> np.ndarray:
     out = np.zeros((len(points), 2))
     at_apex = s <= 1e-12 * max(float(s.max()), 1.0)
     u = rel[~at_apex] / s[~at_apex, None]
-    # Nearest sample of the directrix's direction, then linear between neighbours.
+    # Nearest sample of the directrix's direction, then the segment beside it that the
+    # direction lies nearest; on it, the angle turned from the segment's start (exact where the
+    # cone is flat between two rulings: the direction then lies on their great circle).
     k = np.argmax(u @ table.T, axis=1)
     k = np.clip(k, 1, len(table) - 2)
     best = np.empty(len(k))
@@ -151,7 +153,8 @@ def _develop_general_cone(surface, points: np.ndarray) -> np.ndarray:
         ab = b - a
         t = np.clip(((u - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
         d = np.linalg.norm(a + t[:, None] * ab - u, axis=1)
-        value = theta[k + shift] + t * step[k + shift]
+        within = np.arccos(np.clip((u * a).sum(axis=1), -1.0, 1.0))
+        value = theta[k + shift] + np.where(t > 0.0, np.minimum(within, step[k + shift]), 0.0)
         if shift == -1:
             best_d, best = d, value
         else:
