@@ -9,6 +9,7 @@ import subprocess
 import zlib
 from pathlib import Path
 
+import build123d as bd
 import ezdxf
 import numpy as np
 import pytest
@@ -441,3 +442,147 @@ def _welded(v, f):
     """The mesh with vertices at the same coordinates (the seam of a whole turn) made one."""
     _, index, inverse = np.unique(np.round(v, 9), axis=0, return_index=True, return_inverse=True)
     return v[index], inverse.ravel()[f]
+
+
+# --------------------------------------------------------------------------- #
+# The ASTM file read back entity by entity (mutation testing found it untested)
+# --------------------------------------------------------------------------- #
+
+
+def _block_entities(doc):
+    """``{block name: [entities]}`` for every piece inserted in model space."""
+    return {ins.dxf.name: list(doc.blocks[ins.dxf.name]) for ins in doc.modelspace().query("INSERT")}
+
+
+def test_astm_pieces_read_back_entity_by_entity(tmp_path):
+    """A box's six faces with a 10 mm allowance, ASTM: per piece, the cut line (layer 1) is the face
+    grown by 10 mm, the sew line (14) the face itself, turn points (2) at exactly the four corners
+    and curve points (3) at every other cut vertex, the five piece-text lines on layer 1 in order,
+    inside the piece, 0.6 x the label height (3 % of the piece's size), the strain line on 15 below
+    them, a vertical grain line (7) inside the seam line; block names are unique and legal."""
+    sizes = sorted([(200.0, 100.0), (200.0, 50.0), (100.0, 50.0)] * 2)
+    pattern = patterns.flatten(patterns.load(bd.Box(200, 100, 50), max_edge=25))
+    path = tmp_path / "box_astm.dxf"
+    pattern.to_dxf(path, profile="astm", seam_allowance=10.0)
+    doc = read(path)
+    blocks = _block_entities(doc)
+    assert len(blocks) == 6
+    assert all(re.fullmatch(r"[A-Za-z0-9_\-]{1,31}", name) for name in blocks)
+    assert len({name.upper() for name in blocks}) == 6
+    found = []
+    for name, ents in blocks.items():
+        by = {}
+        for e in ents:
+            by.setdefault((e.dxftype(), e.dxf.layer), []).append(e)
+        (cut,) = by[("POLYLINE", "1")]
+        (sew,) = by[("POLYLINE", "14")]
+        cut_pts = np.array([tuple(v.dxf.location)[:2] for v in cut.vertices])
+        sew_poly = shapely.Polygon([tuple(v.dxf.location)[:2] for v in sew.vertices])
+        x0, y0, x1, y1 = sew_poly.bounds
+        w, h = sorted([x1 - x0, y1 - y0], reverse=True)
+        found.append(tuple(sorted((w, h))))
+        assert sew_poly.area == pytest.approx(w * h, rel=1e-9)
+        assert shapely.Polygon(cut_pts).area == pytest.approx((w + 20) * (h + 20), rel=1e-9)
+        turns = np.array([tuple(p.dxf.location)[:2] for p in by[("POINT", "2")]])
+        curves = np.array([tuple(p.dxf.location)[:2] for p in by.get(("POINT", "3"), [])]).reshape(-1, 2)
+        corners = np.array([[x0 - 10, y0 - 10], [x1 + 10, y0 - 10], [x1 + 10, y1 + 10], [x0 - 10, y1 + 10]])
+        assert len(turns) == 4
+        assert np.abs(np.sort(turns, axis=0) - np.sort(corners, axis=0)).max() < 1e-6
+        assert len(turns) + len(curves) == len(cut_pts)  # every cut vertex is one or the other
+        texts = by[("TEXT", "1")]
+        assert [t.dxf.text for t in texts] == [f"Piece Name:{name}", "Quantity:1", "Material:",
+                                               f"Style Name:{pattern.name}", "Units:METRIC"]
+        th = float(np.clip(0.03 * max(w, h), 2.0, 12.0))
+        ys = [t.dxf.align_point[1] for t in texts]
+        assert np.allclose(np.diff(ys), -th) and all(t.dxf.height == pytest.approx(0.6 * th) for t in texts)
+        assert all(sew_poly.contains(shapely.Point(tuple(t.dxf.align_point)[:2])) for t in texts)
+        (strain,) = [t for t in by[("TEXT", "15")] if t.dxf.text.startswith("STRAIN")]
+        assert strain.dxf.align_point[1] == pytest.approx(ys[0] - 5.5 * th)  # 4 label heights below their middle
+        assert strain.dxf.height == pytest.approx(0.6 * th)
+        (grain,) = by[("LINE", "7")]
+        a, b = np.array(tuple(grain.dxf.start)[:2]), np.array(tuple(grain.dxf.end)[:2])
+        assert a[0] == pytest.approx(b[0]) and b[1] > a[1]  # along +Y
+        assert sew_poly.contains(shapely.Point(a)) and sew_poly.contains(shapely.Point(b))
+    assert sorted(found) == [tuple(sorted(s)) for s in sizes]
+
+
+def test_astm_internal_lines_are_the_rulings_of_a_rolled_panel(tmp_path):
+    """bend_spacing on a rolled cylinder: the ASTM internal lines (layer 8) are the machine
+    profile's BEND lines, the same segments, inside the piece."""
+    pattern = patterns.flatten(patterns.load(SAMPLES / "rolled_cylinder.step"))
+    astm, machine = tmp_path / "a.dxf", tmp_path / "m.dxf"
+    pattern.to_dxf(astm, profile="astm", bend_spacing=50.0)
+    pattern.to_dxf(machine, bend_spacing=50.0)
+    lines = sorted(tuple(np.round(np.r_[tuple(e.dxf.start)[:2], tuple(e.dxf.end)[:2]], 6))
+                   for ents in _block_entities(read(astm)).values() for e in ents
+                   if e.dxftype() == "LINE" and e.dxf.layer == "8")
+    bends = sorted(tuple(np.round(np.r_[tuple(e.dxf.start)[:2], tuple(e.dxf.end)[:2]], 6))
+                   for e in read(machine).modelspace().query('LINE[layer=="BEND"]'))
+    assert len(lines) == len(bends) > 0
+    np.testing.assert_allclose(lines, bends, atol=1e-6)
+
+
+def test_block_names_and_turning_angles():
+    from patterns.export.dxf import _block_name, _turning
+
+    used = set()
+    assert _block_name("face 1/a", used) == "face_1_a"
+    assert _block_name("FACE_1_A", used) == "FACE_1_A_2"  # unique without regard to case
+    assert _block_name("face 1/a", used) == "face_1_a_3"
+    assert _block_name("", used) == "PIECE"
+    long = _block_name("x" * 40, used)
+    assert long == "x" * 31 and _block_name("x" * 40, used) == "x" * 28 + "_2"
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    np.testing.assert_allclose(_turning(square), [np.pi / 2, 0.0, np.pi / 2, np.pi / 2, np.pi / 2], atol=1e-12)
+    triangle = np.array([[0.0, 0.0], [4.0, 0.0], [0.0, 3.0]])
+    inner = np.array([np.pi / 2, np.arctan2(3, 4), np.arctan2(4, 3)])
+    np.testing.assert_allclose(_turning(triangle), np.pi - inner, atol=1e-12)
+
+
+@pytest.mark.parametrize("corners", ["mitre", "square"])
+def test_each_seam_gets_its_own_allowance(tmp_path, corners):
+    """seam_allowance={None: 5, s: 15}: along every seam segment away from the corners, the cut
+    line lies exactly that segment's allowance outside the seam line (shapely distances from the
+    segment's middle, on the file read back; the panels placed 300 mm apart so that each piece's
+    place is known)."""
+    flat = patterns.flatten(patterns.load(bd.Box(200, 100, 50), max_edge=25))
+    pattern = flat.placed([(0.0, 300.0 * k, 0.0) for k in range(len(flat.panels))])
+    wide = max(pattern.seams, key=lambda fs: fs.length).seam.id  # a 200 mm edge: segments away from its ends
+    path = tmp_path / "box.dxf"
+    pattern.to_dxf(path, seam_allowance={None: 5.0, wide: 15.0}, seam_corners=corners)
+    cuts = _polygons(read(path), "CUT")
+    checked = {5.0: 0, 15.0: 0}
+    for fs in pattern.seams:
+        allowance = 15.0 if fs.seam.id == wide else 5.0
+        for side, p in enumerate(fs.seam.panels):
+            panel = pattern.panels[p]
+            inside = shapely.Point(panel.uv.mean(axis=0))
+            (cut,) = [c for c in cuts if c.contains(inside)]
+            pts = panel.uv[np.asarray(fs.seam.vertices[side])]
+            for a, b in zip(pts[1:-2], pts[2:-1]):  # away from the seam's ends (the corners)
+                assert cut.exterior.distance(shapely.Point((a + b) / 2)) == pytest.approx(allowance, abs=1e-6)
+                checked[allowance] += 1
+    assert checked[5.0] > 0 and checked[15.0] > 0
+
+
+def test_write_outline_dxf_checks_every_loop_and_writes_them_as_given(tmp_path):
+    from patterns.export.dxf import write_outline_dxf
+
+    path = tmp_path / "outline.dxf"
+    bad = {"three columns": [[0, 0, 0], [1, 0, 0], [1, 1, 0]], "two points": [[0, 0], [1, 0]],
+           "a NaN": [[0, 0], [1, np.nan], [1, 1]], "flat list": [0, 0, 1, 0, 1, 1]}
+    for why, loop in bad.items():
+        with pytest.raises(InputError, match=r"outline.dxf: loop 1 is not a finite"):
+            write_outline_dxf(path, [np.array([[0, 0], [1, 0], [0, 1]]), np.array(loop, dtype=float)])
+    with pytest.raises(InputError, match="unknown unit 'ft'; choose one of mm, cm, m, in"):
+        write_outline_dxf(path, [np.array([[0, 0], [1, 0], [0, 1]])], units="ft")
+    assert not path.exists()
+    square, hole = np.array([[0, 0], [50, 0], [50, 40], [0, 40]]), np.array([[10, 10], [10, 20], [20, 20]])
+    write_outline_dxf(path, [square, hole], units="in", layer="OUTLINE")
+    doc = read(path)
+    assert doc.dxfversion == "AC1015" and doc.header["$INSUNITS"] == 1 and doc.header["$MEASUREMENT"] == 0
+    assert doc.layers.get("OUTLINE").color == 1
+    got = [np.array(e.get_points("xy")) for e in doc.modelspace().query('LWPOLYLINE[layer=="OUTLINE"]')]
+    assert all(e.closed for e in doc.modelspace().query("LWPOLYLINE"))
+    np.testing.assert_array_equal(got[0], square)
+    np.testing.assert_array_equal(got[1], hole)
