@@ -571,7 +571,7 @@ def test_write_outline_dxf_checks_every_loop_and_writes_them_as_given(tmp_path):
     path = tmp_path / "outline.dxf"
     bad = {"three columns": [[0, 0, 0], [1, 0, 0], [1, 1, 0]], "two points": [[0, 0], [1, 0]],
            "a NaN": [[0, 0], [1, np.nan], [1, 1]], "flat list": [0, 0, 1, 0, 1, 1]}
-    for why, loop in bad.items():
+    for loop in bad.values():
         with pytest.raises(InputError, match=r"outline.dxf: loop 1 is not a finite"):
             write_outline_dxf(path, [np.array([[0, 0], [1, 0], [0, 1]]), np.array(loop, dtype=float)])
     with pytest.raises(InputError, match="unknown unit 'ft'; choose one of mm, cm, m, in"):
