@@ -31,6 +31,7 @@ from .mesh import (
     edge_graph,
     edge_tables,
     trace_loops,
+    unique_edges,
 )
 
 __all__ = ["Cut", "Inserted", "cut_along", "cut_to_disk", "insert_line", "pieces"]
@@ -350,7 +351,7 @@ def insert_line(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, start, 
     v, f, uv = np.asarray(vertices, dtype=np.float64), np.asarray(faces, dtype=np.int64), np.asarray(uv, np.float64)
     a, d = np.asarray(start, dtype=np.float64), np.asarray(end, dtype=np.float64) - np.asarray(start, dtype=np.float64)
     n = len(v)
-    edges = np.unique(np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1), axis=0)
+    edges = unique_edges(f)
     flat_len = np.linalg.norm(uv[edges[:, 1]] - uv[edges[:, 0]], axis=1)
     mean_len = np.bincount(edges.ravel(), weights=np.repeat(flat_len, 2), minlength=n) / np.maximum(
         np.bincount(edges.ravel(), minlength=n), 1)
@@ -386,33 +387,42 @@ def insert_line(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, start, 
 
 
 def _split_faces(faces: np.ndarray, point_of: dict, uv: np.ndarray) -> np.ndarray:
-    """Split every face with a new point on one or two of its edges (winding kept)."""
-    out = []
-    for face in faces.tolist():
+    """Split every face with a new point on one or two of its edges (winding kept, order kept).
+
+    Only the faces the line crosses are visited in Python; the others are kept as they are.
+    """
+    if not point_of:
+        return faces.copy()
+    n = len(uv)
+    lo, hi = np.minimum(faces, np.roll(faces, -1, axis=1)), np.maximum(faces, np.roll(faces, -1, axis=1))
+    keys = np.array([a * n + b for a, b in point_of], dtype=np.int64)  # side k of a face runs corner k -> k + 1
+    touched = np.flatnonzero(np.isin(lo * n + hi, keys).any(axis=1))
+    out, kept_from = [], 0
+    for i, face in zip(touched.tolist(), faces[touched].tolist()):
+        out.append(faces[kept_from:i])  # the faces before this one, in their order
+        kept_from = i + 1
         marks = []
         for k in range(3):
             x, y = face[k], face[(k + 1) % 3]
             point = point_of.get((min(x, y), max(x, y)))
             if point is not None:
                 marks.append((k, point))
-        if not marks:
-            out.append(face)
-        elif len(marks) == 1:
+        if len(marks) == 1:
             (k, pt), = marks
             x, y, z = face[k], face[(k + 1) % 3], face[(k + 2) % 3]
-            out += [[x, pt, z], [pt, y, z]]
+            out.append(np.array([[x, pt, z], [pt, y, z]]))
         elif len(marks) == 2:
             (k1, p1), (k2, p2) = marks
             if k2 != (k1 + 1) % 3:  # the points lie on edges k2 and k1: start from the earlier
                 (k1, p1), (k2, p2) = (k2, p2), (k1, p1)
             x, y, z = face[k1], face[(k1 + 1) % 3], face[(k1 + 2) % 3]  # p1 on x-y, p2 on y-z
-            out.append([p1, y, p2])
             first = [[x, p1, p2], [x, p2, z]]
             second = [[x, p1, z], [p1, p2, z]]
-            out += max(first, second, key=lambda tris: min(_min_angle(uv[t]) for t in tris))
+            out.append(np.array([[p1, y, p2], *max(first, second, key=lambda tris: min(_min_angle(uv[t]) for t in tris))]))
         else:  # a straight line crosses a triangle's sides at most twice
             raise MeshTopologyError("a straight line crossed all three sides of a triangle")
-    return np.asarray(out, dtype=np.int64).reshape(-1, 3)
+    out.append(faces[kept_from:])
+    return np.concatenate(out).astype(np.int64).reshape(-1, 3)
 
 
 def _min_angle(points: np.ndarray) -> float:
@@ -425,7 +435,7 @@ def _min_angle(points: np.ndarray) -> float:
 
 def _joined(stops: np.ndarray, faces: np.ndarray, n: int, vertices: np.ndarray) -> np.ndarray:
     """The stops in order, joined by the shortest edge path wherever two in a row share no edge."""
-    edges = np.unique(np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1), axis=0)
+    edges = unique_edges(faces)
     known = set(map(tuple, edges.tolist()))
     path = [int(stops[0])] if len(stops) else []
     graph = None

@@ -39,6 +39,16 @@ def leg_lengths(flat, dart):
     return [float(np.linalg.norm(np.diff(flat.uv[leg], axis=0), axis=1).sum()) for leg in dart.legs]
 
 
+def assert_seams_true(pattern):
+    """Every seam side of the pattern as long flat as the seam's 3D polyline (both measured here
+    from the points), to 0.01 mm."""
+    for fs in pattern.seams:
+        length_3d = np.linalg.norm(np.diff(fs.seam.points, axis=0), axis=1).sum()
+        for side, p in enumerate(fs.seam.panels):
+            uv = pattern.panels[p].uv[np.asarray(fs.seam.vertices[side])]
+            assert np.linalg.norm(np.diff(uv, axis=0), axis=1).sum() == pytest.approx(length_3d, abs=0.01)
+
+
 @pytest.fixture(scope="module")
 def hemisphere():
     solid = bd.Sphere(R, arc_size1=0)  # the upper half: a spherical face and the disk closing it
@@ -163,11 +173,7 @@ def test_every_panel_of_a_dome_in_gores_meets_the_limit_and_its_seams_stay_true(
             assert abs(a - b) < 0.1
     # The darts cut no seam: every seam side is as long flat as its 3D polyline (measured here
     # from the panels' points), both sides alike.
-    for fs in pattern.seams:
-        length_3d = np.linalg.norm(np.diff(fs.seam.points, axis=0), axis=1).sum()
-        for side, p in enumerate(fs.seam.panels):
-            uv = pattern.panels[p].uv[np.asarray(fs.seam.vertices[side])]
-            assert np.linalg.norm(np.diff(uv, axis=0), axis=1).sum() == pytest.approx(length_3d, abs=0.01)
+    assert_seams_true(pattern)
     assert patterns.check(pattern).ok
 
 
@@ -198,11 +204,7 @@ def test_gores_split_a_dome_into_pieces_that_each_meet_the_limit(hemisphere, sou
     # as the cut is in 3D (measured here), to 0.01 mm.
     new = gores.seams[len(model.seams):]
     assert len(new) >= len(gores.panels) - len(model.panels)
-    for fs in pattern.seams:
-        length_3d = np.linalg.norm(np.diff(fs.seam.points, axis=0), axis=1).sum()
-        for side, p in enumerate(fs.seam.panels):
-            uv = pattern.panels[p].uv[np.asarray(fs.seam.vertices[side])]
-            assert np.linalg.norm(np.diff(uv, axis=0), axis=1).sum() == pytest.approx(length_3d, abs=0.01)
+    assert_seams_true(pattern)
     assert patterns.check(pattern).ok
     if source == "hemisphere":  # 13 gores: held at 3D length, a gore may be 2 sqrt(2 x 3 %) rad wide
         assert len(gores.panels) == int(np.ceil(2 * np.pi / (2 * np.sqrt(2 * LIMIT))))

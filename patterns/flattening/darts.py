@@ -98,10 +98,10 @@ def cut_darts(result: Flattening, limit: float, max_darts: int, held, options: d
         dart lines put in and cut) and its darts.  Where no count up to
         ``max_darts`` meets the limit, the darts that came closest.
     """
-    if max_darts < 1 or _worst(result) <= limit:
+    if max_darts < 1 or worst_strain(result) <= limit:
         return result, ()
     h = float(np.mean(edge_lengths(result.uv, unique_edges(result.faces))))
-    best = (_worst(result), result, ())  # the try that came closest, legs not yet sewn
+    best = (worst_strain(result), result, ())  # the try that came closest, legs not yet sewn
     for k in range(1, max_darts + 1):
         lines = dart_lines(result, k, limit)
         longest = _longest_reach(result, lines, _TIP_GAP * h)
@@ -113,7 +113,7 @@ def cut_darts(result: Flattening, limit: float, max_darts: int, held, options: d
             continue
         for _, flat, darts in _shortest(result, lines, longest, tried, limit, held, options):
             sewn = _sewn(flat, darts, held, options)  # shortest darts first: the first whose sewn legs keep it
-            if _kept(sewn) and _worst(sewn) <= limit:
+            if _kept(sewn) and worst_strain(sewn) <= limit:
                 return sewn, darts
     _, flat, darts = best
     if not darts:
@@ -280,7 +280,7 @@ def _attempt(result, lines, fraction, held, options):
         return None  # the seams could not be held with these darts (a flap pinned between dart and seam)
     darts = tuple(Dart(tuple(np.asarray(side, dtype=np.int64) for side in sides), polyline_length(v[path]))
                   for sides, path in zip(cut.sides, paths))
-    return _worst(flat), flat, darts
+    return worst_strain(flat), flat, darts
 
 
 def _shortest(result, lines, longest, found, limit, held, options) -> list:
@@ -328,5 +328,6 @@ def _kept(result: Flattening) -> bool:
     return not result.length_error > _HELD
 
 
-def _worst(result: Flattening) -> float:
+def worst_strain(result: Flattening) -> float:
+    """The largest principal strain of any triangle of a flattening (the limit's measure)."""
     return float(triangle_strains(result.vertices, result.faces, result.uv).magnitude.max())

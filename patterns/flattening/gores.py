@@ -15,14 +15,12 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
-from scipy.sparse import csgraph
 
-from ..cut import cut_along, insert_line
-from ..measure import triangle_strains
+from ..cut import cut_along, insert_line, pieces
 from ..mesh import polyline_length, unique_edges
 from ..model import Model, Seam, panel_from_mesh
 from ..pattern import Flattening
-from .darts import dart_lines
+from .darts import dart_lines, worst_strain
 from .engine import flatten_mesh
 from .seams import held_lengths
 
@@ -55,7 +53,7 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
         limit with the fewest cuts, or, if none does, the one that came
         closest.
     """
-    if _worst(result) <= limit:
+    if worst_strain(result) <= limit:
         return model
     best = (np.inf, model)
     for k in range(1, max_cuts + 1):  # k cuts: k pieces round a crown inside, k + 1 to a crown on the outline
@@ -65,8 +63,8 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
         split = split_panel(model, index, paths)
         if split is None:
             continue
-        pieces = len(split.panels) - len(model.panels) + 1
-        worst = max(_worst(_flat_piece(split, p, options)) for p in range(index, index + pieces))
+        n_pieces = len(split.panels) - len(model.panels) + 1
+        worst = max(worst_strain(_flat_piece(split, p, options)) for p in range(index, index + n_pieces))
         if worst < best[0]:
             best = (worst, split)
         if worst <= limit:
@@ -88,19 +86,19 @@ def split_panel(model: Model, index: int, paths) -> Model | None:
     vertices, faces, cuts = paths
     panel = model.panels[index]
     cut = cut_along(vertices, faces, cuts, name=panel.name)
-    n_pieces, label = csgraph.connected_components(_face_graph(cut.faces), directed=False)
-    if n_pieces < 2:
+    groups = pieces(cut.faces, len(cut.vertices), name=panel.name)
+    if len(groups) < 2:
         return None
-    pieces, local = [], np.full(len(cut.vertices), -1, dtype=np.int64)
+    parts, local = [], np.full(len(cut.vertices), -1, dtype=np.int64)
     owner = np.full(len(cut.vertices), -1, dtype=np.int64)
-    for j in range(n_pieces):
-        f = cut.faces[label == j]
+    for j, group in enumerate(groups):
+        f = cut.faces[group]
         used = np.unique(f)
         local[used] = np.arange(len(used))
         owner[used] = j
-        pieces.append(panel_from_mesh(f"{panel.name}-{j + 1}", cut.vertices[used], np.searchsorted(used, f),
+        parts.append(panel_from_mesh(f"{panel.name}-{j + 1}", cut.vertices[used], np.searchsorted(used, f),
                                       name=f"{model.name}: panel {panel.name}-{j + 1}"))
-    k = n_pieces
+    k = len(groups)
     renumber = np.array([p if p < index else p + k - 1 for p in range(len(model.panels))])
     seams = []
     for seam in model.seams:
@@ -118,7 +116,7 @@ def split_panel(model: Model, index: int, paths) -> Model | None:
         points = cut.vertices[left]
         seams.append(Seam(len(seams), (index + a, index + b), points, (local[left], local[right]),
                           polyline_length(points)))
-    panels = model.panels[:index] + tuple(pieces) + model.panels[index + 1:]
+    panels = model.panels[:index] + tuple(parts) + model.panels[index + 1:]
     return Model(model.name, panels, tuple(seams), model.max_edge, model.bookkeeping)
 
 
@@ -128,19 +126,6 @@ def _on_one_piece(source, owner, chain):
     counts = np.bincount(np.concatenate([owner[c] for c in copies]))
     piece = int(np.argmax(counts))
     return piece, np.array([c[owner[c] == piece][0] for c in copies], dtype=np.int64)
-
-
-def _face_graph(faces):
-    """Faces joined where they share an edge (after a cut, the pieces are its components)."""
-    import scipy.sparse as sp
-
-    m = len(faces)
-    half = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], axis=2), axis=2).reshape(-1, 2)
-    owner = np.repeat(np.arange(m), 3)
-    order = np.lexsort((half[:, 1], half[:, 0]))
-    same = np.all(half[order][1:] == half[order][:-1], axis=1)
-    a, b = owner[order][:-1][same], owner[order][1:][same]
-    return sp.coo_matrix((np.ones(len(a)), (a, b)), shape=(m, m))
 
 
 def _gore_paths(result: Flattening, k: int, limit: float):
@@ -186,6 +171,3 @@ def _flat_piece(model: Model, p: int, options: dict) -> Flattening:
     held = held_lengths(model, p, panel.vertices, {}, mesh_edges=unique_edges(panel.faces))
     return flatten_mesh(panel.vertices, panel.faces, lengths=held, **options)
 
-
-def _worst(result: Flattening) -> float:
-    return float(triangle_strains(result.vertices, result.faces, result.uv).magnitude.max())

@@ -106,9 +106,7 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
             held = None
             if method == "relaxed":
                 held = held_lengths(model, i, vertices, eased, mode, mesh_edges=unique_edges(panel.faces))
-            options = dict(method=method, max_iterations=opts.max_iterations,
-                           energy_tolerance=opts.energy_tolerance, min_stretch=opts.min_stretch, energy=opts.energy,
-                           name=name)
+            options = _engine_options(opts, name)
             result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
             if max_strain is not None and not opts.gores:
                 result, darts = cut_darts(result, max_strain, max_darts, held, options)
@@ -129,6 +127,12 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
                    max_strain=opts.max_strain)
 
 
+def _engine_options(opts: FlattenOptions, name: str) -> dict:
+    """The keywords of :func:`flatten_mesh` that ``opts`` sets (darts and gores flatten with them too)."""
+    return {"method": opts.method, "max_iterations": opts.max_iterations, "energy_tolerance": opts.energy_tolerance,
+            "min_stretch": opts.min_stretch, "energy": opts.energy, "name": name}
+
+
 def _split_into_gores(model: Model, opts: FlattenOptions, offset: float, keep: set) -> Model:
     """``gores=True``: every freeform panel above the strain limit split into gores (:mod:`.gores`).
 
@@ -142,8 +146,7 @@ def _split_into_gores(model: Model, opts: FlattenOptions, offset: float, keep: s
         name = f"{model.name}: panel {panel.name}"
         vertices = offset_along_normals(panel, offset) if offset else panel.vertices
         held = held_lengths(model, i, vertices, {}, SeamLengths(opts.seams), mesh_edges=unique_edges(panel.faces))
-        options = dict(method=opts.method, max_iterations=opts.max_iterations, energy_tolerance=opts.energy_tolerance,
-                       min_stretch=opts.min_stretch, energy=opts.energy, name=name)
+        options = _engine_options(opts, name)
         result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
         model = gored(model, i, result, opts.max_strain, opts.max_darts, options)
     return model
