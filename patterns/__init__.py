@@ -10,9 +10,14 @@ The public API, all importable from the top level::
     result = patterns.flatten_mesh(vertices, faces)   # (n, 3), (m, 3) arrays in
     result.uv                                         # (n, 2) flat positions, 1:1
     result.overlap.one_to_one, result.distortion.strain_rms
+
+    blank = patterns.unfold("bracket.step", k_factor=0.44)   # bent sheet metal: one flat blank
+    blank.to_dxf("bracket.dxf")                        # outline, holes, bend lines
 """
 
 from .audit import CheckOptions, Code, DartReport, Finding, PanelReport, Report, SeamReport, Severity, check
+from .blank import Bend, Blank, BlankCode, BlankFinding
+from .comparison import BlankComparison, compare_blank, read_flat_pattern
 from .cut import Cut, cut_to_disk
 from .errors import (
     CadError,
@@ -28,6 +33,7 @@ from .export.dxf import DxfOptions
 from .flattening import METHODS, Flattening, FlattenOptions, flatten, flatten_mesh
 from .flattening.energy import ENERGIES
 from .flattening.seams import Ease, SeamLengths
+from .flattening.sheetmetal import BendTable, UnfoldOptions, read_bend_table, unfold
 from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
 from .model import Bookkeeping, Model, Panel, Seam, Surface, SurfaceKind
@@ -43,6 +49,12 @@ __version__ = "0.1.0"
 __all__ = [
     "ENERGIES",
     "METHODS",
+    "Bend",
+    "BendTable",
+    "Blank",
+    "BlankCode",
+    "BlankComparison",
+    "BlankFinding",
     "Bookkeeping",
     "CadError",
     "CheckOptions",
@@ -81,9 +93,11 @@ __all__ = [
     "StrainStats",
     "Surface",
     "SurfaceKind",
+    "UnfoldOptions",
     "Unit",
     "__version__",
     "check",
+    "compare_blank",
     "cut_to_disk",
     "distortion",
     "flatten",
@@ -94,8 +108,11 @@ __all__ = [
     "mesh_shape",
     "overlap_verdict",
     "preview_dxf",
+    "read_bend_table",
     "read_cad",
+    "read_flat_pattern",
     "read_mesh",
     "tessellate_face",
+    "unfold",
     "validate_mesh",
 ]

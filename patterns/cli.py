@@ -9,6 +9,8 @@ Subcommands::
     patterns info INPUT
     patterns demo [-o DIR]
     patterns batch DIR -o OUTDIR [--jobs N] [--scheduler ADDRESS]
+    patterns unfold PART.STEP -o BLANK.dxf [--k-factor K] [--bend-table CSV] [--fixed-face N]
+                    [--report OUT.json] [--compare THEIRS.dxf]
 
 Exit codes: 0 done, 1 the pattern fails a check the user asked for
 (``--max-strain``, ``--max-seam-mismatch``) or has an overlap, 2 bad input or
@@ -68,6 +70,7 @@ def _parser() -> argparse.ArgumentParser:
     from .audit import CheckOptions
     from .export.dxf import DxfOptions
     from .flattening import FlattenOptions
+    from .flattening.sheetmetal import UnfoldOptions
     from .options import add_arguments
     from .reading import LoadOptions
 
@@ -121,6 +124,14 @@ def _parser() -> argparse.ArgumentParser:
 
     demo = sub.add_parser("demo", help="run the whole pipeline on a bundled sample into ./patterns-demo/")
     demo.add_argument("-o", "--output", type=Path, default=Path("patterns-demo"), help="folder (default ./patterns-demo)")
+
+    unf = sub.add_parser("unfold", help="unfold a bent sheet-metal part into one flat blank with bend lines (.dxf)")
+    unf.add_argument("input", type=Path, help="the folded solid: CAD file (.step .stp .brep .iges .igs)")
+    unf.add_argument("-o", "--output", type=Path, required=True, help="the blank, .dxf (CUT, BEND, LABEL layers)")
+    add_arguments(unf.add_argument_group("unfolding"), UnfoldOptions)
+    unf.add_argument("--report", type=Path, default=None, help="write the JSON report here (bends, size, usage)")
+    unf.add_argument("--compare", type=Path, default=None, metavar="DXF",
+                     help="a flat pattern of the same part from another CAD program: print how far ours lies from it")
 
     batch = sub.add_parser("batch", help="flatten every CAD and mesh file in a folder, in parallel")
     batch.add_argument("folder", type=Path, help="folder of input files (not searched recursively)")
@@ -430,7 +441,69 @@ def _cmd_batch(args) -> int:
     return EXIT_CHECK if failed else EXIT_OK
 
 
-COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "demo": _cmd_demo,
+def _cmd_unfold(args) -> int:
+    from .comparison import compare_blank, read_flat_pattern
+    from .flattening.sheetmetal import UnfoldOptions, unfold
+    from .options import from_arguments
+
+    if args.output.suffix.lower() != ".dxf":
+        raise InputError(f"{args.output}: unfold writes a .dxf blank")
+    if args.report is not None and args.report.suffix.lower() != ".json":
+        raise InputError(f"{args.report}: --report writes .json")
+    written = [args.output] + ([args.report] if args.report is not None else [])
+    for out in written:
+        if out.resolve() == args.input.resolve() or (args.compare and out.resolve() == args.compare.resolve()):
+            raise InputError(f"{out}: is an input of this run; name another output")
+    if args.report is not None and args.report.resolve() == args.output.resolve():
+        raise InputError(f"{args.report}: the report and the blank cannot be the same file")
+    for out in written:
+        if out.exists() and out.is_dir():
+            raise InputError(f"{out}: is a folder; name a file")
+        if not (out.parent if str(out.parent) else Path(".")).is_dir():
+            raise InputError(f"{out}: folder {out.parent} does not exist")
+    options = from_arguments(UnfoldOptions, args, name=str(args.input))  # the bend table read and checked here
+    reference = read_flat_pattern(args.compare) if args.compare is not None else None
+    start = time.perf_counter()
+    blank = unfold(args.input, options)
+    seconds = time.perf_counter() - start
+    w, h = blank.size
+    print(f"{args.input}: sheet {blank.thickness:g} mm, {len(blank.bends)} bends, {len(blank.holes)} holes; "
+          f"blank {w:.2f} x {h:.2f} mm, area {blank.area:.1f} mm2, usage {blank.usage:.1%} (unfolded in "
+          f"{seconds:.2f} s)")
+    rows = [("bend", "direction", "angle deg", "inside R mm", "allowance mm")]
+    rows += [(str(k), b.direction, f"{b.angle:.2f}", f"{b.inside_radius:g}", f"{b.allowance:.4f}")
+             for k, b in enumerate(blank.bends)]
+    if blank.bends:
+        _table(rows)
+    for f in blank.findings:
+        print(f"  {'error' if f.error else 'warning'}: {f.message}")
+    extra = {}
+    if reference is not None:
+        c = compare_blank(blank, reference)
+        print(f"against {args.compare}: area {c.area_error:+.4%}, outer perimeter {c.perimeter - c.perimeter_reference:+.3f}"
+              f" mm, holes {c.holes}/{c.holes_reference}, bend lines {c.bend_lines}/{c.bend_lines_reference}, outline "
+              f"Hausdorff {c.hausdorff:.3f} mm ({c.within:.1%} of it within 0.1 mm)")
+        extra["comparison"] = {"reference": str(args.compare), "area_error": c.area_error,
+                               "perimeter_mm": c.perimeter, "perimeter_reference_mm": c.perimeter_reference,
+                               "holes_reference": c.holes_reference, "bend_lines_reference": c.bend_lines_reference,
+                               "hausdorff_mm": c.hausdorff, "hausdorff_all_mm": c.hausdorff_all,
+                               "within_0.1mm": c.within, "mirrored": c.mirrored}
+    if not blank.ok:
+        print(f"{args.output}: not written (the blank cannot be cut as it is)")
+        return EXIT_CHECK
+    blank.to_dxf(args.output)
+    print(f"wrote {args.output}")
+    if args.report is not None:
+        try:
+            blank.to_json(args.report, extra=extra)
+        except BaseException:
+            args.output.unlink(missing_ok=True)  # a failed run leaves nothing
+            raise
+        print(f"wrote {args.report}")
+    return EXIT_OK
+
+
+COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "demo": _cmd_demo, "unfold": _cmd_unfold,
             "batch": _cmd_batch}
 
 

@@ -21,6 +21,7 @@ samples and tests go with it), so the working tree is never touched.
 from __future__ import annotations
 
 import argparse
+import fnmatch
 import re
 import shutil
 import subprocess
@@ -58,8 +59,15 @@ def _venv() -> Path:
     return python
 
 
-def run(module: str, tests: list, python: Path) -> dict:
-    """Run mutmut on one module in a copy of the repository: ``{"killed", "survived", "timeout", "survivors"}``."""
+def _chosen(name: str, only) -> bool:
+    return not only or any(fnmatch.fnmatchcase(name, pattern) for pattern in only)
+
+
+def run(module: str, tests: list, python: Path, *, only=(), max_children=None) -> dict:
+    """Run mutmut on one module in a copy of the repository: ``{"killed", "survived", "timeout", "survivors"}``.
+
+    ``only``: mutant-name patterns (``patterns.export.dxf.x__notches__mutmut_*``) to run instead of
+    every mutant of the module; ``max_children``: at most this many test processes at once."""
     with tempfile.TemporaryDirectory(prefix="patterns-mutation-") as tmp:
         work = Path(tmp) / "repo"
         shutil.copytree(REPO, work, ignore=shutil.ignore_patterns(".git", ".venv", ".mutation-venv", "mutants",
@@ -71,13 +79,14 @@ def run(module: str, tests: list, python: Path) -> dict:
         with open(work / "pyproject.toml", "a") as fh:
             fh.write(config)
         mutmut = [str(python), "-m", "mutmut"]
-        done = subprocess.run([*mutmut, "run"], cwd=work, capture_output=True, text=True)
+        children = [] if max_children is None else ["--max-children", str(max_children)]
+        done = subprocess.run([*mutmut, "run", *children, *only], cwd=work, capture_output=True, text=True)
         listing = subprocess.run([*mutmut, "results", "--all", "true"], cwd=work, capture_output=True,
                                  text=True).stdout
         diffs = {name: subprocess.run([*mutmut, "show", name], cwd=work, capture_output=True, text=True).stdout
                  for name, state in re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M)
-                 if state.strip() == "survived"}
-    status = re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M)
+                 if state.strip() == "survived" and _chosen(name, only)}
+    status = [(n, st) for n, st in re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M) if _chosen(n, only)]
     if not status or all(state.strip() not in ("killed", "survived", "timeout") for _, state in status):
         # mutmut stopped before mutating (its clean run of the tests failed, say): show why
         raise SystemExit(f"mutmut made no mutants of {module}:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
@@ -93,6 +102,9 @@ def run(module: str, tests: list, python: Path) -> dict:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("modules", nargs="*", default=list(MODULES), help="modules (default: the five)")
+    parser.add_argument("--only", nargs="+", default=(), metavar="PATTERN",
+                        help="run only the mutants whose names match (fnmatch), e.g. 'patterns.export.dxf.x__notches__*'")
+    parser.add_argument("--max-children", type=int, default=None, help="test processes at once (default: mutmut's)")
     args = parser.parse_args(argv)
     python = _venv()
     total_k = total_s = 0
@@ -100,7 +112,7 @@ def main(argv=None) -> int:
     print("| module | mutants | killed (timeouts included) | survived | score |")
     print("|---|---|---|---|---|", flush=True)
     for module in args.modules:
-        r = run(module, MODULES.get(module, ["tests/"]), python)
+        r = run(module, MODULES.get(module, ["tests/"]), python, only=args.only, max_children=args.max_children)
         killed = r["killed"] + r["timeout"]
         total_k, total_s = total_k + killed, total_s + r["survived"]
         score = killed / max(killed + r["survived"], 1)

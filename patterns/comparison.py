@@ -1,0 +1,274 @@
+"""Compare a blank with a flat pattern another CAD program made (SolidWorks, FreeCAD, ...).
+
+A shop that moves to `patterns` checks its blanks against the flat patterns it
+cut before.  :func:`read_flat_pattern` reads such a DXF -- its cut contours
+(LINE, ARC, CIRCLE, polylines, chained end to end) and its bend lines (the BEND
+layer, or a centre linetype as SolidWorks draws them) -- and
+:func:`compare_blank` sets the two side by side: area, outer perimeter, holes,
+bend lines, and how far the outlines lie apart once the best rigid motion
+(mirror allowed: a blank may be drawn from either side) has put one on the
+other (Hausdorff distance).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from .errors import InputError
+
+__all__ = ["BlankComparison", "FlatPattern", "compare_blank", "read_flat_pattern"]
+
+_JOIN = 1e-3
+"""Contour pieces whose ends lie closer than this (mm) are joined."""
+
+
+@dataclass(frozen=True, eq=False)
+class FlatPattern:
+    """A flat pattern read from a DXF.
+
+    Attributes
+    ----------
+    outline : (k, 2) float64, mm
+        The outer contour (counter-clockwise, not closed).
+    holes : tuple of (j, 2) float64, mm
+    bend_lines : (b, 2, 2) float64, mm
+    """
+
+    outline: np.ndarray
+    holes: tuple
+    bend_lines: np.ndarray
+
+    @property
+    def polygon(self) -> shapely.Polygon:
+        return shapely.Polygon(self.outline, list(self.holes))
+
+    @property
+    def area(self) -> float:
+        return float(self.polygon.area)
+
+    @property
+    def perimeter(self) -> float:
+        return float(shapely.LinearRing(self.outline).length)
+
+
+def _is_bend(entity) -> bool:
+    layer = entity.dxf.get("layer", "0").upper()
+    linetype = entity.dxf.get("linetype", "BYLAYER").upper()
+    return "BEND" in layer or linetype.startswith(("CENTER", "DASHDOT"))
+
+
+def _pieces(entity, tolerance: float):
+    """(k, 2) points of a contour entity (open piece), or ("closed", points) for a circle or closed polyline."""
+    kind = entity.dxftype()
+    if kind == "LINE":
+        return False, np.array([entity.dxf.start, entity.dxf.end])[:, :2]
+    if kind == "CIRCLE":
+        c, r = np.array(entity.dxf.center)[:2], entity.dxf.radius
+        n = max(16, int(np.ceil(np.pi / np.arccos(max(1 - tolerance / r, -1.0)))))
+        a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        return True, c + r * np.column_stack([np.cos(a), np.sin(a)])
+    if kind in ("ARC", "LWPOLYLINE", "POLYLINE", "SPLINE", "ELLIPSE"):
+        from ezdxf import path as ezpath
+
+        p = ezpath.make_path(entity)
+        pts = np.array([(v.x, v.y) for v in p.flattening(tolerance)])
+        closed = kind in ("LWPOLYLINE", "POLYLINE") and entity.is_closed
+        return closed, pts[:-1] if closed and np.allclose(pts[0], pts[-1]) else pts
+    return None
+
+
+def read_flat_pattern(path, *, tolerance: float = 0.001) -> FlatPattern:
+    """Read a flat pattern's contours and bend lines from a DXF file (model space, in its own unit).
+
+    Parameters
+    ----------
+    path : str or Path
+    tolerance : float
+        Chord error of arcs and curves sampled as points, mm.
+
+    Raises
+    ------
+    InputError
+        Not a readable DXF, or contours that do not close.
+    """
+    import ezdxf
+
+    try:
+        doc = ezdxf.readfile(str(path))
+    except (OSError, ezdxf.DXFError) as exc:
+        raise InputError(f"{path}: not a readable DXF file ({exc})") from None
+    closed, open_, bends = [], [], []
+    for entity in doc.modelspace():
+        if entity.dxftype() == "LINE" and _is_bend(entity):
+            bends.append(np.array([entity.dxf.start, entity.dxf.end])[:, :2])
+            continue
+        got = _pieces(entity, tolerance)
+        if got is None:
+            continue
+        (closed if got[0] else open_).append(got[1])
+    loops = closed + _chain(open_, path)
+    if not loops:
+        raise InputError(f"{path}: no closed contour")
+    polys = [shapely.Polygon(lp) for lp in loops]
+    outer = int(np.argmax([p.area for p in polys]))
+    outline = np.array(shapely.geometry.polygon.orient(polys[outer], 1.0).exterior.coords)[:-1]
+    holes = tuple(np.array(shapely.geometry.polygon.orient(p, 1.0).exterior.coords)[-2::-1]
+                  for k, p in enumerate(polys) if k != outer)
+    return FlatPattern(outline, holes, np.array(bends).reshape(-1, 2, 2))
+
+
+def _chain(pieces, path):
+    """Join open pieces end to end into closed loops."""
+    pieces = [p for p in pieces if len(p) >= 2]
+    loops = []
+    used = np.zeros(len(pieces), bool)
+    starts = np.array([p[0] for p in pieces]).reshape(-1, 2)
+    ends = np.array([p[-1] for p in pieces]).reshape(-1, 2)
+    for k in range(len(pieces)):
+        if used[k]:
+            continue
+        used[k] = True
+        loop = [pieces[k]]
+        first, at = pieces[k][0], pieces[k][-1]
+        while np.linalg.norm(at - first) > _JOIN:
+            free = np.flatnonzero(~used)
+            if len(free) == 0:
+                raise InputError(f"{path}: a contour does not close (open end at x {at[0]:.3f}, y {at[1]:.3f})")
+            ds, de = np.linalg.norm(starts[free] - at, axis=1), np.linalg.norm(ends[free] - at, axis=1)
+            j = int(np.argmin(np.minimum(ds, de)))
+            if min(ds[j], de[j]) > _JOIN:
+                raise InputError(f"{path}: a contour does not close (open end at x {at[0]:.3f}, y {at[1]:.3f})")
+            i = free[j]
+            used[i] = True
+            piece = pieces[i] if ds[j] <= de[j] else pieces[i][::-1]
+            loop.append(piece[1:])
+            at = piece[-1]
+        pts = np.concatenate(loop)
+        loops.append(pts[:-1] if np.linalg.norm(pts[-1] - pts[0]) <= _JOIN else pts)
+    return loops
+
+
+@dataclass(frozen=True, eq=False)
+class BlankComparison:
+    """A blank beside a reference flat pattern (each figure ours, then theirs).
+
+    Attributes
+    ----------
+    area, area_reference : float
+        Material area (outline less holes), mm².
+    perimeter, perimeter_reference : float
+        Outer contour length, mm.
+    holes, holes_reference : int
+    bend_lines, bend_lines_reference : int
+    hausdorff : float
+        Largest distance between the two outer contours after the best rigid alignment, mm.
+    hausdorff_all : float
+        The same over every contour (outline and holes), mm.
+    within : float
+        The share of our outer contour (by length) within 0.1 mm of theirs.
+    mirrored : bool
+        The reference is drawn from the other side of the sheet.
+    """
+
+    area: float
+    area_reference: float
+    perimeter: float
+    perimeter_reference: float
+    holes: int
+    holes_reference: int
+    bend_lines: int
+    bend_lines_reference: int
+    hausdorff: float
+    hausdorff_all: float
+    within: float
+    mirrored: bool
+
+    @property
+    def area_error(self) -> float:
+        """Relative area difference (ours less theirs, over theirs)."""
+        return (self.area - self.area_reference) / self.area_reference
+
+
+def _resample(loop: np.ndarray, step: float) -> np.ndarray:
+    closed = np.vstack([loop, loop[:1]])
+    seg = np.linalg.norm(np.diff(closed, axis=0), axis=1)
+    s = np.concatenate([[0], np.cumsum(seg)])
+    t = np.arange(0, s[-1], step)
+    return np.column_stack([np.interp(t, s, closed[:, 0]), np.interp(t, s, closed[:, 1])])
+
+
+def _align(ours: np.ndarray, theirs: np.ndarray):
+    """Rotation (2, 2, maybe a mirror) and shift putting ``ours`` (points) best onto ``theirs``."""
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(theirs)
+    ca, cb = ours.mean(axis=0), theirs.mean(axis=0)
+    _, va = np.linalg.eigh(np.cov((ours - ca).T))
+    _, vb = np.linalg.eigh(np.cov((theirs - cb).T))
+    best = None
+    for sx in (1, -1):
+        for sy in (1, -1):
+            rot = vb @ np.diag([sx, sy]) @ va.T
+            shift = cb - ca @ rot.T
+            for _ in range(300):  # iterative closest points, both ways
+                moved = ours @ rot.T + shift
+                dk, k = tree.query(moved)
+                dj, j = cKDTree(moved).query(theirs)
+                # trimmed: the worst tenth of the pairs (a corner drawn another way) does not pull the fit
+                a, b = dk <= np.quantile(dk, 0.9), dj <= np.quantile(dj, 0.9)
+                src = np.vstack([ours[a], ours[j[b]]])
+                dst = np.vstack([theirs[k[a]], theirs[b]])
+                cs, cd = src.mean(axis=0), dst.mean(axis=0)
+                u, _, vt = np.linalg.svd((src - cs).T @ (dst - cd))
+                hand = np.sign(np.linalg.det(rot)) * np.sign(np.linalg.det(u @ vt))  # keep the start's handedness
+                new = (u @ np.diag([1, hand]) @ vt).T
+                shift_new = cd - cs @ new.T
+                if np.allclose(new, rot, atol=1e-12) and np.allclose(shift_new, shift, atol=1e-9):
+                    break
+                rot, shift = new, shift_new
+            d = tree.query(ours @ rot.T + shift)[0].mean()
+            if best is None or d < best[0]:
+                best = (d, rot, shift)
+    return best[1], best[2]
+
+
+def compare_blank(blank, reference) -> BlankComparison:
+    """Compare a blank (a :class:`patterns.Blank`, or a flat-pattern DXF path) with a reference flat-pattern DXF.
+
+    The contours (outline and holes) are aligned by a rigid motion (a mirror allowed), fitted
+    by trimmed iterative closest points (the nearest pairs both ways, the worst
+    tenth left out, so that one corner drawn differently does not shift the
+    rest) from the four principal-axis placements; the Hausdorff distance is then measured on contours resampled
+    every 0.02 mm.
+    """
+    from scipy.spatial import cKDTree
+
+    ref = reference if isinstance(reference, FlatPattern) else read_flat_pattern(reference)
+    if isinstance(blank, (str, Path)):
+        ours = read_flat_pattern(blank)
+        outline, holes, bends = ours.outline, ours.holes, len(ours.bend_lines)
+        area, perimeter = ours.area, ours.perimeter
+    else:
+        outline, holes = blank.outline.points(), tuple(h.points() for h in blank.holes)
+        bends, area, perimeter = len(blank.bends), blank.area, blank.perimeter
+    rot, shift = _align(np.vstack([_resample(lp, 0.5) for lp in (outline, *holes)]),
+                        np.vstack([_resample(lp, 0.5) for lp in (ref.outline, *ref.holes)]))
+
+    def distances(a_loops, b_loops):
+        a = np.vstack([_resample(lp, 0.02) for lp in a_loops]) @ rot.T + shift
+        b = np.vstack([_resample(lp, 0.02) for lp in b_loops])
+        return cKDTree(b).query(a)[0], cKDTree(a).query(b)[0]
+
+    there, back = distances([outline], [ref.outline])
+
+    return BlankComparison(
+        area=area, area_reference=ref.area, perimeter=perimeter, perimeter_reference=ref.perimeter,
+        holes=len(holes), holes_reference=len(ref.holes), bend_lines=bends, bend_lines_reference=len(ref.bend_lines),
+        hausdorff=float(max(there.max(), back.max())),
+        hausdorff_all=float(max(d.max() for d in distances([outline, *holes], [ref.outline, *ref.holes]))),
+        within=float(np.mean(there <= 0.1)),
+        mirrored=bool(np.linalg.det(rot) < 0))

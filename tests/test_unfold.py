@@ -1,0 +1,293 @@
+"""Sheet metal: a bent part unfolds into one blank (``patterns.unfold``, ``patterns unfold``).
+
+References are independent of the unfolder: the neutral-layer length of a bent
+strip built with build123d (``la + lb + angle (r + k t)``), a bend-deduction
+table's own arithmetic, the written DXF read back (ezdxf, dxf2gcode, FreeCAD),
+and SolidWorks' flat patterns of four real parts (``../shared/sheetmetal``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import build123d as bd
+import ezdxf
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+import patterns
+from patterns.cli import main
+from patterns.comparison import _resample
+
+SHEETMETAL = Path(__file__).resolve().parent.parent.parent / "shared" / "sheetmetal"
+READERS = Path(__file__).resolve().parent / "readers"
+PARTS = {  # SolidWorks' figures from ../shared/sheetmetal/README.md: area mm², outer perimeter mm, holes, bend lines
+    "MMP.00.00.00.002_Back_panel": (79828.8, 1231.17, 15, 4),
+    "MMP.01.00.00.001_Cover": (383025.3, 2663.69, 15, 10),
+    "MMP.03.00.00.001_Wheel_bracket_outer": (38289.7, 1074.45, 22, 3),
+    "MMP.05.00.00.001_Support": (16902.6, 870.54, 12, 4),
+}
+K = 0.47  # the parts' K-factor (their README)
+
+
+def bent_strip(*, la=60.0, lb=40.0, width=30.0, r=2.0, t=1.5, angle=90.0, hole=0.0):
+    """A strip of thickness t bent once (inside radius r, by ``angle`` degrees) about an axis along y:
+    flange A (la long) in z in [-t, 0] along -x, flange B (lb long) after the bend; a hole in flange A."""
+    th = np.radians(angle)
+
+    def arc(rad, frac):
+        a = -np.pi / 2 + th * frac
+        return (rad * np.cos(a), 0.0, r + rad * np.sin(a))
+
+    d = np.array([np.cos(th), 0.0, np.sin(th)])
+    i1, i2, o1, o2 = (0, 0, 0), arc(r, 1), (0, 0, -t), arc(r + t, 1)
+    i3, o3 = tuple(np.array(i2) + lb * d), tuple(np.array(o2) + lb * d)
+    edge = bd.Edge
+    edges = [edge.make_line((-la, 0, 0), i1), edge.make_three_point_arc(i1, arc(r, 0.5), i2),
+             edge.make_line(i2, i3), edge.make_line(i3, o3), edge.make_line(o3, o2),
+             edge.make_three_point_arc(o2, arc(r + t, 0.5), o1), edge.make_line(o1, (-la, 0, -t)),
+             edge.make_line((-la, 0, -t), (-la, 0, 0))]
+    solid = bd.extrude(bd.Face(bd.Wire(edges)), amount=width, dir=(0, 1, 0))
+    if hole:
+        solid -= bd.Pos(-la / 2, width / 2, 0) * bd.Cylinder(hole, 4 * t)
+    return solid
+
+
+def _need_parts():
+    if not SHEETMETAL.is_dir():
+        pytest.skip(f"{SHEETMETAL} is absent (the shared sheet-metal parts sit beside the repository in CI)")
+
+
+# --------------------------------------------------------------------------- #
+# The development: analytic lengths
+# --------------------------------------------------------------------------- #
+
+
+@pytest.mark.parametrize("angle", [60.0, 90.0, 135.0])
+def test_bent_strip_unfolds_to_its_neutral_length(angle):
+    k, r, t, width = 0.4, 2.0, 1.5, 30.0
+    blank = patterns.unfold(bent_strip(angle=angle, r=r, t=t, width=width, hole=4.0), k_factor=k)
+    length = 60.0 + 40.0 + np.radians(angle) * (r + k * t)  # flange A + flange B + the neutral arc
+    assert blank.thickness == pytest.approx(t, abs=1e-9)
+    assert blank.perimeter == pytest.approx(2 * (length + width), abs=1e-6)
+    assert blank.area == pytest.approx(length * width - np.pi * 16.0, rel=2e-5)  # the hole sampled within 1 µm
+    assert sorted(blank.size) == pytest.approx(sorted([length, width]), abs=1e-6)
+    (bend,) = blank.bends
+    assert bend.angle == pytest.approx(angle, abs=1e-9)
+    assert bend.inside_radius == pytest.approx(r, abs=1e-9)
+    assert bend.allowance == pytest.approx(np.radians(angle) * (r + k * t), abs=1e-9)
+    assert bend.direction == "up"  # flange B rises towards the side the fixed face shows
+    # The bend line: across the whole width, in the middle of the bend zone: 60 + allowance / 2 from flange A's end.
+    assert np.linalg.norm(bend.line[1] - bend.line[0]) == pytest.approx(width, abs=1e-6)
+    outline = blank.outline.points()
+    distances = (outline - bend.line[0]) @ _normal(bend.line)
+    assert sorted([abs(distances.min()), abs(distances.max())]) == pytest.approx(
+        sorted([60 + bend.allowance / 2, 40 + bend.allowance / 2]), abs=1e-6)
+    (hole,) = blank.holes
+    assert hole.is_circle and hole.pieces[0].radius == pytest.approx(4.0, abs=1e-9)
+
+
+def _unit(line):
+    d = line[1] - line[0]
+    return d / np.linalg.norm(d)
+
+
+def _normal(line):
+    d = _unit(line)
+    return np.array([-d[1], d[0]])
+
+
+def test_k_factor_moves_the_length_by_angle_times_thickness():
+    a = patterns.unfold(bent_strip(), k_factor=0.3)
+    b = patterns.unfold(bent_strip(), k_factor=0.5)
+    assert max(b.size) - max(a.size) == pytest.approx(np.radians(90) * 0.2 * 1.5, abs=1e-9)
+
+
+def test_bend_table_gives_the_bend_deduction(tmp_path):
+    table = tmp_path / "bends.csv"
+    table.write_text("thickness,radius,angle,deduction\n1.5,2,60,1.0\n1.5,2,120,3.0\n2,2,90,9\n")
+    blank = patterns.unfold(bent_strip(), bend_table=table)
+    # 90 degrees lies half-way between the rows of 60 and 120: BD 2.0.  Mold-line flanges: la + r + t, lb + r + t.
+    assert max(blank.size) == pytest.approx((60 + 2 + 1.5) + (40 + 2 + 1.5) - 2.0, abs=1e-9)
+    assert blank.k_factor is None
+    with pytest.raises(patterns.InputError, match=r"bends.csv: no row for thickness 1.5 mm, inside radius 2 mm"):
+        patterns.unfold(bent_strip(angle=150), bend_table=table)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("thickness,radius,angle,deduction\n1.5,2,x,1\n")
+    with pytest.raises(patterns.InputError, match=r"bad.csv, line 2: every value must be a number"):
+        patterns.unfold(bent_strip(), bend_table=bad)
+
+
+# --------------------------------------------------------------------------- #
+# Faults: never a wrong blank
+# --------------------------------------------------------------------------- #
+
+
+def test_a_machined_block_is_not_a_sheet():
+    block = bd.Box(100, 100, 20) - bd.Pos(0, 0, 5) * bd.Box(50, 50, 10)
+    with pytest.raises(patterns.InputError, match="not a sheet"):
+        patterns.unfold(block)
+
+
+def test_a_square_tube_with_no_seam_is_refused_with_where_to_cut():
+    outer = bd.fillet(bd.Box(60, 60, 100).edges().filter_by(bd.Axis.Z), 5)
+    inner = bd.fillet(bd.Box(56, 56, 100).edges().filter_by(bd.Axis.Z), 3)
+    with pytest.raises(patterns.InputError, match="closes on itself.*cut it"):
+        patterns.unfold(outer - inner)
+
+
+def test_a_round_tube_is_refused():
+    with pytest.raises(patterns.InputError, match="closed tube.*cut it"):
+        patterns.unfold(bd.Cylinder(20, 100) - bd.Cylinder(18, 100))
+
+
+def test_flanges_that_land_on_the_plate_are_an_error_and_no_dxf(tmp_path):
+    # A flange bent up from the edge of a window, longer than the window: unfolded, it lies on the plate.
+    strip = bent_strip(la=30, lb=60, width=20, r=2, t=1.5)
+    frame = bd.Pos(20, 10, -0.75) * bd.Box(160, 80, 1.5) - bd.Pos(12, 10, -0.75) * bd.Box(24, 30, 1.5)
+    part = strip + frame
+    blank = patterns.unfold(part)
+    assert not blank.ok
+    assert [f.code for f in blank.findings if f.error] == [patterns.BlankCode.FLANGES_OVERLAP]
+    with pytest.raises(patterns.ExportError, match="not written"):
+        blank.to_dxf(tmp_path / "x.dxf")
+    assert list(tmp_path.iterdir()) == []
+
+
+# --------------------------------------------------------------------------- #
+# The DXF, read back
+# --------------------------------------------------------------------------- #
+
+
+@pytest.fixture(scope="module")
+def strip_blank():
+    return patterns.unfold(bent_strip(hole=4.0, angle=90), k_factor=0.4)
+
+
+def test_dxf_holds_the_blank_and_its_bend_lines(strip_blank, tmp_path):
+    path = tmp_path / "blank.dxf"
+    strip_blank.to_dxf(path)
+    doc = ezdxf.readfile(path)
+    assert doc.header["$INSUNITS"] == 4 and doc.header["$MEASUREMENT"] == 1
+    msp = doc.modelspace()
+    (outline,) = msp.query("LWPOLYLINE[layer=='CUT']")
+    assert outline.closed
+    (circle,) = msp.query("CIRCLE[layer=='CUT']")
+    assert circle.dxf.radius == pytest.approx(4.0, abs=1e-12)
+    assert len(msp.query("LINE[layer=='BEND']")) == 1
+    assert doc.layers.get("BEND").dxf.linetype == "CENTER"
+    texts = [t.dxf.text for t in msp.query("TEXT[layer=='BEND']")]
+    assert texts == ["UP 90.0 DEG R2"]
+    read = patterns.read_flat_pattern(path)
+    assert read.area == pytest.approx(strip_blank.area, rel=1e-6)
+    assert read.perimeter == pytest.approx(strip_blank.perimeter, rel=1e-9)
+    assert len(read.bend_lines) == 1
+    x0, y0 = read.outline.min(axis=0)
+    assert (x0, y0) == pytest.approx((5.0, 5.0), abs=1e-9)  # first quadrant, 5 mm from the axes
+
+
+def test_dxf2gcode_reads_closed_contours(strip_blank, tmp_path):
+    if shutil.which("dxf2gcode") is None:
+        pytest.skip("dxf2gcode is not installed (.ci/run installs it with apt-get)")
+    path = tmp_path / "blank.dxf"
+    strip_blank.to_dxf(path)
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(tmp_path), HOME=str(tmp_path))
+    proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
+                          capture_output=True, text=True, env=env, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    found = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert found["entities"]["CUT"] == {"contours": 2, "closed": 2}
+    assert found["metric"] is True
+
+
+def test_freecad_reads_the_blank_closed_at_its_area(strip_blank, tmp_path):
+    if shutil.which("freecadcmd") is None:
+        pytest.skip("freecadcmd is not installed (.ci/run installs it with apt-get)")
+    path = tmp_path / "blank.dxf"
+    strip_blank.to_dxf(path)
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(tmp_path), HOME=str(tmp_path),
+               DXF=str(path))
+    proc = subprocess.run(["freecadcmd", str(READERS / "freecad_layers.py")], capture_output=True, text=True,
+                          env=env, timeout=300)
+    lines = [x for x in proc.stdout.splitlines() if "RESULT " in x]
+    assert lines, proc.stdout[-2000:] + proc.stderr[-2000:]
+    layers = json.loads(lines[-1].split("RESULT ", 1)[1])
+    wires = sorted(w["area"] for w in layers["CUT"]["closed_wires"])
+    assert wires == pytest.approx(sorted([np.pi * 16.0, strip_blank.outline.area]), rel=1e-4)
+    assert "BEND" in layers
+
+
+# --------------------------------------------------------------------------- #
+# Real parts against SolidWorks' flat patterns
+# --------------------------------------------------------------------------- #
+
+
+@pytest.mark.parametrize("part", sorted(PARTS))
+def test_real_part_matches_solidworks(part):
+    _need_parts()
+    area, perimeter, holes, bends = PARTS[part]
+    blank = patterns.unfold(SHEETMETAL / f"{part}.STEP", k_factor=K)
+    assert blank.ok
+    assert abs(blank.area - area) <= 0.0005 * area
+    assert len(blank.holes) == holes
+    assert len(blank.bends) == bends
+    c = patterns.compare_blank(blank, SHEETMETAL / f"{part}.DXF")
+    assert c.area_reference == pytest.approx(area, abs=0.5)  # our reading of their DXF agrees with their figures
+    if part in ("MMP.03.00.00.001_Wheel_bracket_outer", "MMP.01.00.00.001_Cover"):
+        assert abs(blank.perimeter - perimeter) <= 0.5
+    if part == "MMP.03.00.00.001_Wheel_bracket_outer":
+        assert c.hausdorff <= 0.1
+
+
+@pytest.mark.parametrize("part", [
+    pytest.param(p, marks=pytest.mark.xfail(strict=True, reason="the Cover's flange-end regions lie 0.10-0.16 mm "
+                                            "from SolidWorks' over 60 mm around its four corners (docs/sheet-metal.md)"))
+    if p == "MMP.01.00.00.001_Cover" else p for p in sorted(PARTS)])
+def test_where_the_outline_differs_from_solidworks_it_is_at_a_corner(part):
+    """Every stretch of our outline more than 0.1 mm from SolidWorks' lies within 8 mm of the end of one of
+    their bend lines: the corners, where two bends meet and SolidWorks draws its own corner relief."""
+    _need_parts()
+    blank = patterns.unfold(SHEETMETAL / f"{part}.STEP", k_factor=K)
+    ref = patterns.read_flat_pattern(SHEETMETAL / f"{part}.DXF")
+    from patterns.comparison import _align
+
+    ours = [blank.outline.points(), *[h.points() for h in blank.holes]]
+    rot, shift = _align(np.vstack([_resample(lp, 0.5) for lp in ours]),
+                        np.vstack([_resample(lp, 0.5) for lp in (ref.outline, *ref.holes)]))
+    ours = _resample(blank.outline.points(), 0.05) @ rot.T + shift
+    far = ours[cKDTree(_resample(ref.outline, 0.02)).query(ours)[0] > 0.1]
+    ends = ref.bend_lines.reshape(-1, 2)
+    if len(far):
+        assert cKDTree(ends).query(far)[0].max() <= 8.0
+
+
+def test_each_part_unfolds_through_the_command_line(tmp_path, capsys):
+    _need_parts()
+    part = "MMP.03.00.00.001_Wheel_bracket_outer"
+    out, report = tmp_path / "blank.dxf", tmp_path / "blank.json"
+    code = main(["unfold", str(SHEETMETAL / f"{part}.STEP"), "-o", str(out), "--k-factor", str(K),
+                 "--report", str(report), "--compare", str(SHEETMETAL / f"{part}.DXF")])
+    assert code == 0
+    data = json.loads(report.read_text())
+    assert data["holes"] == 22 and len(data["bends"]) == 3
+    assert data["comparison"]["hausdorff_mm"] <= 0.1
+    read = patterns.read_flat_pattern(out)
+    assert read.area == pytest.approx(data["area_mm2"], rel=1e-4)
+    assert "Hausdorff" in capsys.readouterr().out
+
+
+def test_command_line_refuses_bad_input_in_one_line_and_writes_nothing(tmp_path, capsys):
+    step = tmp_path / "strip.step"
+    bd.export_step(bent_strip(), str(step))
+    out = tmp_path / "blank.dxf"
+    for argv in (["--k-factor", "1.5"], ["--bend-table", str(tmp_path / "none.csv")], ["--fixed-face", "999"]):
+        assert main(["unfold", str(step), "-o", str(out), *argv]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith("patterns: error: ")
+    assert main(["unfold", str(step), "-o", str(step)]) == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["strip.step"]
