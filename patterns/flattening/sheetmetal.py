@@ -14,7 +14,8 @@ followed from a fixed face across every bend, is the blank:
    *neutral* width, ``a (r + k t)`` (``k`` the K-factor), or the width a bend
    table gives; a face's own parameters ``(u, v)`` map to the flat linearly
    (``(R_n u, v)`` on a cylinder), so lines stay lines and a hole's circle on a
-   plane stays a circle.  No mesh, no relaxation, no strain.
+   plane stays a circle.  A conical bend rolls out to the annular sector of its
+   neutral cone (polar about the apex).  No mesh, no relaxation, no strain.
 3. **Join them.**  From the fixed face outwards, each face is turned and moved
    (a rigid motion, never mirrored) so that the edge it shares with a placed
    face lands on that face's copy of it.  Every other shared edge is checked to
@@ -147,13 +148,16 @@ class UnfoldOptions(Options):
 class _Face:
     index: int
     face: object
-    kind: str  # "plane", "cylinder" or "other"
+    kind: str  # "plane", "cylinder", "cone" or "other"
     area: float
     adaptor: object
     origin: np.ndarray = None
     axis: np.ndarray = None
     radius: float = 0.0
-    scale: np.ndarray = None  # (2,) the flat is (scale[0] u, scale[1] v) before placing
+    semi_angle: float = 0.0  # cone: OpenCascade's signed half-angle, radians
+    scale: np.ndarray = None  # (2,) plane, cylinder: the flat is (scale[0] u, scale[1] v) before placing
+    offset: float = 0.0  # cone: the neutral surface lies this far from the skin, towards the convex side, mm
+    mirror: float = 1.0  # cone: -1 when the polar development is flipped to keep the skin's orientation
     rotation: np.ndarray = None  # (2, 2) placed: rotation @ local + shift
     shift: np.ndarray = None
 
@@ -180,7 +184,24 @@ class _Face:
         return 1.0 if cross @ self.normal(u, v) > 0 else -1.0
 
     def local(self, uv: np.ndarray) -> np.ndarray:
-        return np.asarray(uv) * self.scale
+        """(k, 2) parameters to the face's own flat coordinates, mm: linear on planes and cylinders; on a
+        cone, polar about the apex (distance from it along the generator, of the neutral surface; angle
+        ``u sin a``)."""
+        uv = np.asarray(uv, dtype=np.float64)
+        if self.kind != "cone":
+            return uv * self.scale
+        a = abs(self.semi_angle)
+        s = np.abs(uv[:, 1] + self.radius / np.sin(self.semi_angle)) + self.offset / np.tan(a)
+        phi = uv[:, 0] * np.sin(a)
+        return np.column_stack([s * np.cos(phi), self.mirror * s * np.sin(phi)])
+
+    def normal_radius(self, u: float, v: float) -> float:
+        """Radius of curvature across the bend, mm: the cylinder's radius, a cone's distance from the
+        point to its axis over cos(a) (along the normal)."""
+        if self.kind == "cylinder":
+            return self.radius
+        rel = self.point(u, v) - self.origin
+        return float(np.linalg.norm(rel - (rel @ self.axis) * self.axis) / np.cos(self.semi_angle))
 
     def flat(self, uv: np.ndarray) -> np.ndarray:
         """(k, 2) parameters on the face to (k, 2) positions on the blank, mm."""
@@ -190,7 +211,7 @@ class _Face:
 def _faces(topology):
     from OCP.BRepAdaptor import BRepAdaptor_Surface
     from OCP.BRepGProp import BRepGProp
-    from OCP.GeomAbs import GeomAbs_Cylinder, GeomAbs_Plane
+    from OCP.GeomAbs import GeomAbs_Cone, GeomAbs_Cylinder, GeomAbs_Plane
     from OCP.GProp import GProp_GProps
 
     out = []
@@ -199,13 +220,15 @@ def _faces(topology):
         props = GProp_GProps()
         BRepGProp.SurfaceProperties_s(face, props)
         kind = adaptor.GetType()
-        f = _Face(i, face, "plane" if kind == GeomAbs_Plane else "cylinder" if kind == GeomAbs_Cylinder else "other",
-                  props.Mass(), adaptor)
-        if f.kind == "cylinder":
-            ax = adaptor.Cylinder().Position()
+        named = {GeomAbs_Plane: "plane", GeomAbs_Cylinder: "cylinder", GeomAbs_Cone: "cone"}
+        f = _Face(i, face, named.get(kind, "other"), props.Mass(), adaptor)
+        if f.kind in ("cylinder", "cone"):
+            surface = adaptor.Cylinder() if f.kind == "cylinder" else adaptor.Cone()
+            ax = surface.Position()
             loc, d = ax.Location(), ax.Direction()
             f.origin, f.axis = np.array([loc.X(), loc.Y(), loc.Z()]), np.array([d.X(), d.Y(), d.Z()])
-            f.radius = adaptor.Cylinder().Radius()
+            f.radius = surface.Radius() if f.kind == "cylinder" else surface.RefRadius()
+            f.semi_angle = 0.0 if f.kind == "cylinder" else surface.SemiAngle()
         out.append(f)
     return out
 
@@ -307,9 +330,10 @@ def _skin(topology, faces, fixed, name):
                              f"(a tube with no seam): cut it along a line first")
     other = sorted(i for i in skin if faces[i].kind == "other")
     if other:
-        raise FlattenError(f"{name}: faces {', '.join(map(str, other))} of the sheet are neither planes nor "
-                           f"cylinders; unfold develops planes and cylindrical bends exactly "
-                           f"(use patterns.flatten for freeform parts)")
+        raise FlattenError(f"{name}: faces {', '.join(map(str, other))} of the sheet are neither planes, "
+                           f"cylinders nor cones: not developable as they are; unfold develops planes and "
+                           f"cylindrical and conical bends exactly (patterns.flatten develops freeform "
+                           f"panels, with their strain)")
     return skin, neighbours
 
 
@@ -322,7 +346,7 @@ def _sheet_volume(faces, skin, thickness) -> float:
             total += f.area * thickness
         else:
             r_in = f.inside_radius
-            total += f.area / f.radius * ((r_in + thickness) ** 2 - r_in ** 2) / 2
+            total += f.area / f.bend_radius * ((r_in + thickness) ** 2 - r_in ** 2) / 2
     return total
 
 
@@ -408,10 +432,11 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
         outward = f.point(u, v) - f.origin
         outward -= (outward @ f.axis) * f.axis
         f.concave = bool(f.normal(u, v) @ outward < 0)
-        f.inside_radius = f.radius if f.concave else f.radius - thickness
+        f.bend_radius = f.normal_radius(u, v)
+        f.inside_radius = f.bend_radius if f.concave else f.bend_radius - thickness
         if f.inside_radius < -1e-9:
-            raise InputError(f"{name}: face {i} bends tighter than the sheet is thick (radius {f.radius:g} mm, "
-                             f"thickness {thickness:g} mm): not a sheet")
+            raise InputError(f"{name}: face {i} bends tighter than the sheet is thick (radius "
+                             f"{f.bend_radius:g} mm, thickness {thickness:g} mm): not a sheet")
         f.inside_radius = max(f.inside_radius, 0.0)
     volume, expected = _volume(shape), _sheet_volume(faces, skin, thickness)
     if abs(volume - expected) > 0.01 * volume:
@@ -435,10 +460,11 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
 
 
 def _bends(topology, faces, skin, neighbours, thickness, opts, name):
-    """Group the skin's cylinders into bends (joined cylinders of one axis and radius); set each one's flat scale."""
+    """Group the skin's cylinders and cones into bends (joined faces of one axis, radius and angle); set each
+    one's flat map."""
     from OCP.BRepTools import BRepTools
 
-    cylinders = sorted(i for i in skin if faces[i].kind == "cylinder")
+    cylinders = sorted(i for i in skin if faces[i].kind in ("cylinder", "cone"))
     group_of = {}
     groups = []
     for i in cylinders:
@@ -450,7 +476,8 @@ def _bends(topology, faces, skin, neighbours, thickness, opts, name):
             a = stack.pop()
             for b, _ in neighbours[a]:
                 fb, fa = faces[b], faces[a]
-                if b in group_of or fb.kind != "cylinder" or abs(fb.radius - fa.radius) > 1e-6:
+                if b in group_of or fb.kind != fa.kind or abs(fb.radius - fa.radius) > 1e-6 or abs(
+                        fb.semi_angle - fa.semi_angle) > 1e-9:
                     continue
                 if abs(abs(fb.axis @ fa.axis) - 1) > 1e-9 or np.linalg.norm(np.cross(fb.origin - fa.origin,
                                                                                        fa.axis)) > 1e-6:
@@ -461,28 +488,57 @@ def _bends(topology, faces, skin, neighbours, thickness, opts, name):
         groups.append(group)
     out = []
     for group in groups:
-        spans = []
-        for i in group:
-            u0, u1, _, _ = BRepTools.UVBounds_s(faces[i].face)
-            spans.append(u1 - u0)
-        angle = float(np.degrees(max(spans)))
         first = faces[group[0]]
-        r_in = first.inside_radius
-        if opts.bend_table is not None:
-            allowance = opts.bend_table.allowance(thickness, r_in, angle)
+        if first.kind == "cone":
+            out.append((group, _cone_bend(faces, group, thickness, opts, name)))
         else:
-            allowance = np.radians(angle) * (r_in + opts.k_factor * thickness)
-        neutral = allowance / np.radians(angle)
-        for i in group:
-            f = faces[i]
-            u, v = _uv_mid(f.face)
-            f.scale = np.array([f.handedness(u, v) * neutral, 1.0])
-        planar = {faces[j].kind == "plane" for i in group for j, _ in neighbours[i] if j not in group}
+            spans = []
+            for i in group:
+                u0, u1, _, _ = BRepTools.UVBounds_s(faces[i].face)
+                spans.append(u1 - u0)
+            angle = float(np.degrees(max(spans)))
+            r_in = first.inside_radius
+            if opts.bend_table is not None:
+                allowance = opts.bend_table.allowance(thickness, r_in, angle)
+            else:
+                allowance = np.radians(angle) * (r_in + opts.k_factor * thickness)
+            neutral = allowance / np.radians(angle)
+            for i in group:
+                f = faces[i]
+                u, v = _uv_mid(f.face)
+                f.scale = np.array([f.handedness(u, v) * neutral, 1.0])
+            out.append((group, {"angle": angle, "inside_radius": r_in, "allowance": float(allowance)}))
+        info = out[-1][1]
         sides = sum(1 for i in group for j, _ in neighbours[i] if faces[j].kind == "plane")
-        out.append((group, {"angle": angle, "inside_radius": r_in, "allowance": float(allowance),
-                            "direction": "up" if first.concave else "down",
-                            "flanged": True in planar and sides >= 2}))
+        info.update(direction="up" if first.concave else "down", flanged=sides >= 2)
     return out
+
+
+def _cone_bend(faces, group, thickness, opts, name) -> dict:
+    """A conical bend: its neutral surface developed exactly (polar about the apex); angle, radius and
+    allowance as measured across its middle."""
+    from OCP.BRepTools import BRepTools
+
+    if opts.bend_table is not None:
+        raise InputError(f"{name}: faces {', '.join(map(str, group))} are a conical bend; a bend table gives "
+                         f"cylindrical bends only (use the K-factor)")
+    for i in group:
+        f = faces[i]
+        f.offset = opts.k_factor * thickness if f.concave else -(1 - opts.k_factor) * thickness
+        u, v = _uv_mid(f.face)
+        f.mirror = 1.0
+        h = 1e-4 * max(1.0, abs(v))
+        jac = np.vstack([f.local(np.array([[u + 1e-6, v]])) - f.local(np.array([[u - 1e-6, v]])),
+                         f.local(np.array([[u, v + h]])) - f.local(np.array([[u, v - h]]))])
+        f.mirror = f.handedness(u, v) * float(np.sign(np.linalg.det(jac)))
+    first = faces[group[0]]
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(first.face)
+    vm = 0.5 * (v0 + v1)
+    angle = float(np.degrees(np.arccos(np.clip(first.normal(u0, vm) @ first.normal(u1, vm), -1.0, 1.0))))
+    ends = first.local(np.array([[u0, vm], [u1, vm]]))
+    s_mid = float(np.linalg.norm(ends[0]))
+    return {"angle": angle, "inside_radius": first.inside_radius,
+            "allowance": float(s_mid * abs(u1 - u0) * np.sin(abs(first.semi_angle)))}
 
 
 def _kabsch(src: np.ndarray, dst: np.ndarray):
@@ -541,7 +597,8 @@ def _piece(edge, face, flip: bool):
         return face.flat(np.array(pts))
 
     kind = c2.GetType()
-    if kind == GeomAbs_Line:
+    straight = kind == GeomAbs_Line and (face.kind != "cone" or abs(c2.Line().Direction().X()) < 1e-12)
+    if straight:  # a line of the parameters is a line of the flat, but on a cone only along a generator
         a, b = at([t0, t1])
         return Line(a, b)
     if kind == GeomAbs_Circle and face.kind == "plane":
