@@ -139,6 +139,7 @@ class BlankCode(str, Enum):
 
     FLANGES_OVERLAP = "flanges-overlap"
     BEND_WITHOUT_FLANGE = "bend-without-flange"
+    MESHED_FACE = "meshed-face"
 
 
 @dataclass(frozen=True, eq=False)

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
+import zlib
 from pathlib import Path
 
 import build123d as bd
@@ -127,6 +129,39 @@ def test_conical_bend_unfolds_to_its_neutral_sector():
     assert blank.perimeter == pytest.approx(2 * length + 2 * generator + phi * (s_a + s_b), rel=1e-6)
     assert len(blank.bends) == 1 and blank.bends[0].direction == "up"
     assert blank.bends[0].allowance == pytest.approx(phi * (s_a + s_b) / 2, rel=1e-9)
+    # The cone has a flat face on one side only: a warning, and the blank is still cut.
+    (warning,) = blank.findings
+    assert warning.code is patterns.BlankCode.BEND_WITHOUT_FLANGE and not warning.error and blank.ok
+
+
+def test_a_bend_that_is_no_cylinder_is_meshed_and_says_so():
+    """The bend of a strip drawn as splines (an extrusion surface, not a cylinder) is meshed, moved to
+    its neutral surface and flattened: close to the exact length, with its strain reported."""
+    r, t, k, width = 2.0, 1.5, 0.4, 30.0
+    th = np.radians(90.0)
+
+    def arc(rad, frac):
+        a = -np.pi / 2 + th * frac
+        return (rad * np.cos(a), 0.0, r + rad * np.sin(a))
+
+    i2, o2 = arc(r, 1), arc(r + t, 1)
+    fr = np.linspace(0, 1, 9)
+    edge = bd.Edge
+    edges = [edge.make_line((-60, 0, 0), (0, 0, 0)),
+             edge.make_spline([arc(r, x) for x in fr], tangents=[(1, 0, 0), (0, 0, 1)]),
+             edge.make_line(i2, (r, 0, r + 40)), edge.make_line((r, 0, r + 40), (r + t, 0, r + 40)),
+             edge.make_line((r + t, 0, r + 40), o2),
+             edge.make_spline([arc(r + t, x) for x in fr[::-1]], tangents=[(0, 0, -1), (-1, 0, 0)]),
+             edge.make_line((0, 0, -t), (-60, 0, -t)), edge.make_line((-60, 0, -t), (-60, 0, 0))]
+    part = bd.extrude(bd.Face(bd.Wire(edges)), amount=width, dir=(0, 1, 0))
+    assert "EXTRUSION" in {f.geom_type.name for f in part.faces()}
+    blank = patterns.unfold(part, k_factor=k)
+    length = 100.0 + th * (r + k * t)
+    assert max(blank.size) == pytest.approx(length, abs=0.05)  # the mesh's chords and relaxation: < 0.05 mm
+    assert blank.area == pytest.approx(length * width, rel=5e-4)
+    (finding,) = blank.findings
+    assert finding.code is patterns.BlankCode.MESHED_FACE and not finding.error and blank.ok
+    assert "meshed" in finding.message and "strain up to" in finding.message
 
 
 def test_k_factor_moves_the_length_by_angle_times_thickness():
@@ -216,6 +251,31 @@ def test_dxf_holds_the_blank_and_its_bend_lines(strip_blank, tmp_path):
     assert len(read.bend_lines) == 1
     x0, y0 = read.outline.min(axis=0)
     assert (x0, y0) == pytest.approx((5.0, 5.0), abs=1e-9)  # first quadrant, 5 mm from the axes
+
+
+def test_librecad_renders_a_real_blank(tmp_path):
+    if shutil.which("librecad") is None:
+        pytest.skip("librecad is not installed (.ci/run installs it with apt-get)")
+    _need_parts()
+    blank = patterns.unfold(SHEETMETAL / "MMP.05.00.00.001_Support.STEP", k_factor=K)
+    path = tmp_path / "support.dxf"
+    blank.to_dxf(path)
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(tmp_path), HOME=str(tmp_path))
+    proc = subprocess.run(["librecad", "dxf2pdf", "--fit", str(path)], capture_output=True, text=True, env=env,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = (tmp_path / "support.pdf").read_bytes()
+    content = b"".join(_inflate(s) for s in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, re.DOTALL))
+    # Drawn as vector paths: at least one line-to for every straight piece of the outline.
+    straight = sum(1 for piece in blank.outline.pieces if isinstance(piece, patterns.blank.Line))
+    assert len(re.findall(rb"\sl\s", content)) >= straight
+
+
+def _inflate(stream: bytes) -> bytes:
+    try:
+        return zlib.decompress(stream)
+    except zlib.error:
+        return stream
 
 
 def test_dxf2gcode_reads_closed_contours(strip_blank, tmp_path):

@@ -15,7 +15,9 @@ followed from a fixed face across every bend, is the blank:
    table gives; a face's own parameters ``(u, v)`` map to the flat linearly
    (``(R_n u, v)`` on a cylinder), so lines stay lines and a hole's circle on a
    plane stays a circle.  A conical bend rolls out to the annular sector of its
-   neutral cone (polar about the apex).  No mesh, no relaxation, no strain.
+   neutral cone (polar about the apex).  No mesh, no relaxation, no strain --
+   except on a face that is none of these (a spline bend): it is meshed, moved to
+   its neutral surface, flattened by the engine, and reported with its strain.
 3. **Join them.**  From the fixed face outwards, each face is turned and moved
    (a rigid motion, never mirrored) so that the edge it shares with a placed
    face lands on that face's copy of it.  Every other shared edge is checked to
@@ -158,6 +160,7 @@ class _Face:
     scale: np.ndarray = None  # (2,) plane, cylinder: the flat is (scale[0] u, scale[1] v) before placing
     offset: float = 0.0  # cone: the neutral surface lies this far from the skin, towards the convex side, mm
     mirror: float = 1.0  # cone: -1 when the polar development is flipped to keep the skin's orientation
+    meshed: object = None  # other: its _Meshed development
     rotation: np.ndarray = None  # (2, 2) placed: rotation @ local + shift
     shift: np.ndarray = None
 
@@ -188,6 +191,8 @@ class _Face:
         cone, polar about the apex (distance from it along the generator, of the neutral surface; angle
         ``u sin a``)."""
         uv = np.asarray(uv, dtype=np.float64)
+        if self.kind == "other":
+            return self.meshed.at(np.array([self.point(u, v) for u, v in uv]).reshape(-1, 3))
         if self.kind != "cone":
             return uv * self.scale
         a = abs(self.semi_angle)
@@ -206,6 +211,70 @@ class _Face:
     def flat(self, uv: np.ndarray) -> np.ndarray:
         """(k, 2) parameters on the face to (k, 2) positions on the blank, mm."""
         return self.local(uv) @ self.rotation.T + self.shift
+
+
+@dataclass
+class _Meshed:
+    """A face no plane, cylinder or cone: its skin meshed, the mesh moved to the neutral surface and
+    flattened by the engine (with the strain that costs); points on the face map through the mesh."""
+
+    mesh: object  # trimesh.Trimesh of the skin
+    uv: np.ndarray  # (n, 2) its vertices flattened, mm
+    flattening: object  # patterns.Flattening
+    volume: float  # the sheet behind it, mm³
+    gap: float = 0.0  # how far its edges land from its neighbours', mm
+    _tree: object = None
+
+    def at(self, points: np.ndarray) -> np.ndarray:
+        """(k, 3) points on the face (on its mesh to the tessellation's tolerance) to (k, 2) flat, mm:
+        through the nearest triangle (among those with the nearest centroids), barycentrically."""
+        from scipy.spatial import cKDTree
+
+        vertices, tris = np.asarray(self.mesh.vertices), np.asarray(self.mesh.faces)
+        if self._tree is None:
+            self._tree = cKDTree(vertices[tris].mean(axis=1))
+        cand = self._tree.query(points, k=min(12, len(tris)))[1].reshape(len(points), -1)
+        tri = vertices[tris[cand]]  # (p, k, 3, 3)
+        a = tri[..., 0, :]
+        e0, e1, e2 = tri[..., 1, :] - a, tri[..., 2, :] - a, points[:, None, :] - a
+        d00, d01, d11 = (e0 * e0).sum(-1), (e0 * e1).sum(-1), (e1 * e1).sum(-1)
+        d20, d21 = (e2 * e0).sum(-1), (e2 * e1).sum(-1)
+        den = d00 * d11 - d01 * d01
+        v, w = (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+        bary = np.clip(np.stack([1 - v - w, v, w], axis=-1), 0, None)
+        bary /= bary.sum(axis=-1, keepdims=True)
+        near = np.linalg.norm(np.einsum("pkj,pkjd->pkd", bary, tri) - points[:, None, :], axis=-1).argmin(axis=1)
+        rows = np.arange(len(points))
+        return np.einsum("pj,pjd->pd", bary[rows, near], self.uv[tris[cand[rows, near]]])
+
+
+def _mesh_face(f, thickness, k_factor, name) -> _Meshed:
+    """Mesh and flatten a face that is not developable as a plane, cylinder or cone."""
+    import trimesh
+
+    from ..measure import signed_areas
+    from ..tessellate import mesh_shape
+    from .engine import flatten_mesh
+
+    # well-shaped triangles, half the thickness across (fewer, larger on a large face: about 2000)
+    edge = max(thickness / 2, np.sqrt(f.area / 1000.0))
+    (panel,) = mesh_shape(f.face, max_edge=edge, chord_tolerance=0.002, name=f"{name} face {f.index}").panels
+    vertices, tris = np.asarray(panel.vertices), np.asarray(panel.faces)
+    mesh = trimesh.Trimesh(vertices, tris, process=False)
+    u, v = _uv_mid(f.face)
+    concave = float(np.mean((vertices - f.point(u, v)) @ f.normal(u, v))) > 0  # curving towards its normal
+    into = k_factor * thickness if concave else (1 - k_factor) * thickness  # the neutral surface, into the sheet
+    result = flatten_mesh(vertices - into * mesh.vertex_normals, tris, name=f"{name} face {f.index}")
+    uv = np.array(result.uv)
+    if signed_areas(uv, tris).sum() < 0:
+        uv[:, 1] *= -1
+
+    def area(depth):  # of the skin moved ``depth`` into the sheet
+        tri = (vertices - depth * mesh.vertex_normals)[tris]
+        return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+
+    volume = thickness * (area(0) + 4 * area(thickness / 2) + area(thickness)) / 6  # Simpson across the sheet
+    return _Meshed(mesh, uv, result, float(volume))
 
 
 def _faces(topology):
@@ -328,12 +397,6 @@ def _skin(topology, faces, fixed, name):
         if pair is None and topology.edge_faces[e][0] in skin:
             raise InputError(f"{name}: the sheet closes on itself around face {topology.edge_faces[e][0]} "
                              f"(a tube with no seam): cut it along a line first")
-    other = sorted(i for i in skin if faces[i].kind == "other")
-    if other:
-        raise FlattenError(f"{name}: faces {', '.join(map(str, other))} of the sheet are neither planes, "
-                           f"cylinders nor cones: not developable as they are; unfold develops planes and "
-                           f"cylindrical and conical bends exactly (patterns.flatten develops freeform "
-                           f"panels, with their strain)")
     return skin, neighbours
 
 
@@ -342,7 +405,9 @@ def _sheet_volume(faces, skin, thickness) -> float:
     total = 0.0
     for i in skin:
         f = faces[i]
-        if f.kind == "plane":
+        if f.kind == "other":
+            total += f.meshed.volume
+        elif f.kind == "plane":
             total += f.area * thickness
         else:
             r_in = f.inside_radius
@@ -429,6 +494,9 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
         if f.kind == "plane":
             f.scale = np.array([hand, 1.0])
             continue
+        if f.kind == "other":  # its neutral surface at the K-factor's depth, even with a bend table
+            f.meshed = _mesh_face(f, thickness, opts.k_factor, name)
+            continue
         outward = f.point(u, v) - f.origin
         outward -= (outward @ f.axis) * f.axis
         f.concave = bool(f.normal(u, v) @ outward < 0)
@@ -454,6 +522,16 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
                               f"{name}: bend at faces {', '.join(map(str, b.faces))} has no flat face on one "
                               f"side", b.line.mean(axis=0)) for b, (_, info) in zip(drawn, bends)
                  if not info["flanged"]]
+    for i in sorted(skin):
+        m = faces[i].meshed
+        if m is not None:
+            d = m.flattening.distortion
+            findings.append(BlankFinding(
+                BlankCode.MESHED_FACE, False,
+                f"{name}: face {i} is not developable as a plane, cylinder or cone: meshed "
+                f"({len(m.mesh.faces)} triangles) and flattened, strain up to {d.strain_max:.3%} (rms "
+                f"{d.strain_rms:.3%}); its edges land within {m.gap:.3f} mm of the faces beside it",
+                np.asarray(faces[i].flat(np.array([_uv_mid(faces[i].face)])))[0]))
     return Blank(name=name, outline=outline, holes=holes, bends=drawn, thickness=thickness,
                  k_factor=None if opts.bend_table is not None else opts.k_factor, fixed_face=fixed,
                  findings=tuple(findings))
@@ -572,7 +650,10 @@ def _place(topology, faces, skin, neighbours, fixed, name):
                 edge = topology.edges[e]
                 gap = np.abs(faces[a].flat(_edge_uv(edge, faces[a].face, 5))
                              - faces[b].flat(_edge_uv(edge, faces[b].face, 5))).max()
-                if gap > _MEET:
+                meshed = [faces[k].meshed for k in (a, b) if faces[k].meshed is not None]
+                for m in meshed:
+                    m.gap = max(m.gap, float(gap))
+                if gap > _MEET and not meshed:
                     raise InputError(f"{name}: the sheet closes on itself (faces {a} and {b} land {gap:.3f} mm "
                                      f"apart once unfolded, along edge {e}): a tube or a box with no seam; "
                                      f"cut it along a line first")
@@ -597,7 +678,8 @@ def _piece(edge, face, flip: bool):
         return face.flat(np.array(pts))
 
     kind = c2.GetType()
-    straight = kind == GeomAbs_Line and (face.kind != "cone" or abs(c2.Line().Direction().X()) < 1e-12)
+    straight = kind == GeomAbs_Line and (face.kind in ("plane", "cylinder") or (
+        face.kind == "cone" and abs(c2.Line().Direction().X()) < 1e-12))
     if straight:  # a line of the parameters is a line of the flat, but on a cone only along a generator
         a, b = at([t0, t1])
         return Line(a, b)
@@ -696,7 +778,9 @@ def _overlaps(topology, faces, skin, name):
         if a >= b:
             continue
         common = polys[keys[a]].intersection(polys[keys[b]])
-        if common.area > 0.01:
+        # a meshed face meets its neighbours only to within its gap: a sliver that wide along its edge is no overlap
+        slack = sum(faces[k].meshed.gap * polys[k].length for k in (keys[a], keys[b]) if faces[k].meshed is not None)
+        if common.area > 0.01 + slack:
             point = np.array(common.representative_point().coords[0])
             yield BlankFinding(BlankCode.FLANGES_OVERLAP, True,
                                f"{name}: faces {keys[a]} and {keys[b]} overlap by {common.area:.2f} mm² once "
