@@ -34,3 +34,17 @@ def independent_one_to_one(faces: np.ndarray, uv: np.ndarray) -> bool:
     if not (np.all(shapely.is_ccw(shapely.get_exterior_ring(tris))) and np.all(areas > 0)):
         return False
     return shapely.union_all(tris).area >= (1 - 1e-9) * areas.sum()
+
+
+def drawing_shift(msp, pattern, layer: str) -> np.ndarray:
+    """(2,) the one translation a DXF writer moved a laid-out (or one-panel) pattern by, to put the
+    drawing in the first quadrant: the lower-left corner of ``layer``'s polylines (the seam lines: SEW,
+    or CUT without an allowance) less that of the panels' boundary loops."""
+    pts = []
+    for e in msp.query(f'LWPOLYLINE POLYLINE[layer=="{layer}"]'):
+        if e.dxftype() == "LWPOLYLINE":
+            pts.append(np.array([p[:2] for p in e.get_points("xy")]))
+        else:
+            pts.append(np.array([tuple(v.dxf.location)[:2] for v in e.vertices]))
+    uv = np.vstack([p.uv[np.concatenate(p.loops)] for p in pattern.panels])
+    return np.vstack(pts).min(axis=0) - uv.min(axis=0)

@@ -13,6 +13,7 @@ import patterns
 from patterns.measure import triangle_strains
 
 from .conftest import SAMPLES
+from .helpers import drawing_shift
 
 LIMIT = 0.03
 R = 150.0
@@ -119,7 +120,7 @@ def test_the_report_and_the_dxf_list_every_dart(hemisphere, tmp_path):
     path = tmp_path / "hemisphere.dxf"
     pattern.to_dxf(path)
     msp = ezdxf.readfile(path).modelspace()
-    shift = np.array(msp.query('LWPOLYLINE[layer=="CUT"]')[0].get_points("xy")[0]) - flat.uv[flat.loops[0][0]]
+    shift = drawing_shift(msp, pattern, "CUT")
     drills = np.array([tuple(p.dxf.location)[:2] for p in msp.query('POINT[layer=="DRILL"]')])
     tips = np.array([flat.uv[d.tip] for d in flat.darts]) + shift
     assert len(drills) == len(tips)
@@ -131,11 +132,13 @@ def test_the_report_and_the_dxf_list_every_dart(hemisphere, tmp_path):
                 for line in msp.query('LINE[layer=="NOTCH"]')]
         cut = shapely.Polygon(msp.query('LWPOLYLINE[layer=="CUT"]')[0].get_points("xy"))
         sew = shapely.Polygon(msp.query('LWPOLYLINE[layer=="SEW"]')[0].get_points("xy")) if allowance else cut
-        shift = np.array(sew.exterior.coords[0]) - flat.uv[flat.loops[0][0]]
+        shift = drawing_shift(msp, pattern, "SEW" if allowance else "CUT")
         for dart in flat.darts:
             for leg in dart.legs:
                 mouth = flat.uv[leg[0]] + shift
-                (slit,) = [(a, b) for a, b in ends if np.linalg.norm(a - mouth) < 1e-6]
+                # each slit as (its end at the mouth, its other end): it meets the seam line at the mouth
+                (slit,) = [(a, b) if np.linalg.norm(a - mouth) < 1e-6 else (b, a) for a, b in ends
+                           if min(np.linalg.norm(a - mouth), np.linalg.norm(b - mouth)) < 1e-6]
                 along = flat.uv[leg[1]] - flat.uv[leg[0]]
                 if allowance:  # square to the leg, from the seam line out across its allowance
                     assert abs(np.dot(slit[1] - slit[0], along)) < 1e-6 * np.linalg.norm(along)
@@ -145,7 +148,9 @@ def test_the_report_and_the_dxf_list_every_dart(hemisphere, tmp_path):
                     tip = shapely.Point(slit[1])
                     assert cut.contains(tip) and cut.exterior.distance(tip) > 1.0
                     assert np.linalg.norm(slit[1] - slit[0]) == pytest.approx(3)
-        assert len(sew.exterior.coords) - 1 == len(flat.loops[0])  # the seam line runs into every dart
+        for dart in flat.darts:  # the seam line runs into every dart: its tip is a corner of the seam line
+            tip = flat.uv[dart.tip] + shift
+            assert np.min(np.linalg.norm(np.array(sew.exterior.coords) - tip, axis=1)) < 1e-6
     # ASTM: the drill holes on layer 13.
     astm = tmp_path / "hemisphere_astm.dxf"
     pattern.to_dxf(astm, profile="astm")

@@ -22,6 +22,7 @@ from patterns.export.dxf import MACHINE_LAYERS
 from patterns.export.preview import preview_dxf
 
 from .conftest import SAMPLES
+from .helpers import drawing_shift
 
 READERS = Path(__file__).parent / "readers"
 
@@ -354,7 +355,7 @@ def _polygons(doc, layer):
 
 
 def test_notch_slits_cut_into_the_allowance_never_into_the_piece(cup, tmp_path):
-    """Every slit runs from the seam line out to the cut line, through the seam allowance: its
+    """Every slit runs from the cut line in to the seam line, through the seam allowance: its
     middle lies inside the cut contour and outside every seam line (a slit flipped inwards would
     cut the finished piece)."""
     path = tmp_path / "cup.dxf"
@@ -364,9 +365,9 @@ def test_notch_slits_cut_into_the_allowance_never_into_the_piece(cup, tmp_path):
     lines = doc.modelspace().query('LINE[layer=="NOTCH"]')
     assert len(lines) == 2 * 2 * len(cup.seams)
     for line in lines:
-        a, b = np.array(line.dxf.start)[:2], np.array(line.dxf.end)[:2]
-        assert sew.boundary.distance(shapely.Point(a)) < 1e-6  # starts on the seam line
-        assert cut.boundary.distance(shapely.Point(b)) < 1e-6  # ends on the cut line
+        b, a = np.array(line.dxf.start)[:2], np.array(line.dxf.end)[:2]
+        assert cut.boundary.distance(shapely.Point(b)) < 1e-6  # starts on the cut line
+        assert sew.boundary.distance(shapely.Point(a)) < 1e-6  # ends on the seam line
         mid = shapely.Point((a + b) / 2)
         assert cut.contains(mid) and not sew.contains(mid)
 
@@ -402,7 +403,7 @@ def test_other_units_end_to_end(tmp_path, units):
     from patterns import cli, surfaces
 
     # A whole turn of a cylinder (numbers in `units`): it is cut open, and the cut is a seam with a label.
-    v, f = surfaces.cylinder_patch(radius=2.0, height=5.0, angle=360.0, n_around=40, n_along=8)
+    v, f = surfaces.cylinder_patch(radius=20.0, height=50.0, angle=360.0, n_around=40, n_along=8)
     v, f = _welded(v, f)
     mesh_path = tmp_path / "tube.obj"
     trimesh.Trimesh(v, f, process=False).export(mesh_path)
@@ -493,12 +494,16 @@ def test_astm_pieces_read_back_entity_by_entity(tmp_path):
         assert [t.dxf.text for t in texts] == [f"Piece Name:{name}", "Quantity:1", "Material:",
                                                f"Style Name:{pattern.name}", "Units:METRIC"]
         th = float(np.clip(0.03 * max(w, h), 2.0, 12.0))
+        # 0.6 x the label height, or smaller where the piece is too narrow for the lines (the 50 mm
+        # wide faces): the block shrinks as a whole, its lines a label height apart
+        size = texts[0].dxf.height
+        assert size <= 0.6 * th + 1e-9 and all(t.dxf.height == pytest.approx(size) for t in texts)
         ys = [t.dxf.align_point[1] for t in texts]
-        assert np.allclose(np.diff(ys), -th) and all(t.dxf.height == pytest.approx(0.6 * th) for t in texts)
+        assert np.allclose(np.diff(ys), -size / 0.6)
         assert all(sew_poly.contains(shapely.Point(tuple(t.dxf.align_point)[:2])) for t in texts)
         (strain,) = [t for t in by[("TEXT", "15")] if t.dxf.text.startswith("STRAIN")]
-        assert strain.dxf.align_point[1] == pytest.approx(ys[0] - 5.5 * th)  # 4 label heights below their middle
-        assert strain.dxf.height == pytest.approx(0.6 * th)
+        assert strain.dxf.align_point[1] == pytest.approx(ys[0] - 5.5 * size / 0.6)  # 4 heights below their middle
+        assert strain.dxf.height == pytest.approx(size)
         (grain,) = by[("LINE", "7")]
         a, b = np.array(tuple(grain.dxf.start)[:2]), np.array(tuple(grain.dxf.end)[:2])
         assert a[0] == pytest.approx(b[0]) and b[1] > a[1]  # along +Y
@@ -519,7 +524,11 @@ def test_astm_internal_lines_are_the_rulings_of_a_rolled_panel(tmp_path):
     bends = sorted(tuple(np.round(np.r_[tuple(e.dxf.start)[:2], tuple(e.dxf.end)[:2]], 6))
                    for e in read(machine).modelspace().query('LINE[layer=="BEND"]'))
     assert len(lines) == len(bends) > 0
-    np.testing.assert_allclose(lines, bends, atol=1e-6)
+    # Each file is moved into the first quadrant by its own extents: the same segments up to one shift.
+    lines, bends = np.array(lines), np.array(bends)
+    shift = (bends - lines)[0]
+    np.testing.assert_allclose(lines + shift, bends, atol=1e-6)
+    assert np.ptp(shift[[0, 2]]) < 1e-9 and np.ptp(shift[[1, 3]]) < 1e-9
 
 
 def test_block_names_and_turning_angles():
@@ -550,15 +559,17 @@ def test_each_seam_gets_its_own_allowance(tmp_path, corners):
     wide = max(pattern.seams, key=lambda fs: fs.length).seam.id  # a 200 mm edge: segments away from its ends
     path = tmp_path / "box.dxf"
     pattern.to_dxf(path, seam_allowance={None: 5.0, wide: 15.0}, seam_corners=corners)
-    cuts = _polygons(read(path), "CUT")
+    doc = read(path)
+    cuts = _polygons(doc, "CUT")
+    shift = drawing_shift(doc.modelspace(), pattern, "SEW")
     checked = {5.0: 0, 15.0: 0}
     for fs in pattern.seams:
         allowance = 15.0 if fs.seam.id == wide else 5.0
         for side, p in enumerate(fs.seam.panels):
             panel = pattern.panels[p]
-            inside = shapely.Point(panel.uv.mean(axis=0))
+            inside = shapely.Point(panel.uv.mean(axis=0) + shift)
             (cut,) = [c for c in cuts if c.contains(inside)]
-            pts = panel.uv[np.asarray(fs.seam.vertices[side])]
+            pts = panel.uv[np.asarray(fs.seam.vertices[side])] + shift
             for a, b in zip(pts[1:-2], pts[2:-1]):  # away from the seam's ends (the corners)
                 assert cut.exterior.distance(shapely.Point((a + b) / 2)) == pytest.approx(allowance, abs=1e-6)
                 checked[allowance] += 1
@@ -586,3 +597,146 @@ def test_write_outline_dxf_checks_every_loop_and_writes_them_as_given(tmp_path):
     assert all(e.closed for e in doc.modelspace().query("LWPOLYLINE"))
     np.testing.assert_array_equal(got[0], square)
     np.testing.assert_array_equal(got[1], hole)
+
+
+# --------------------------------------------------------------------------- #
+# Notches: on the cut line, pointing into the piece, at corners too (issue 20)
+# --------------------------------------------------------------------------- #
+
+
+@pytest.fixture(scope="module")
+def notched():
+    """The box, the cup and the square-to-round, flattened once."""
+    return {"box": patterns.flatten(patterns.load(bd.Box(200, 100, 50), max_edge=10)),
+            "cup": patterns.flatten(patterns.load(SAMPLES / "cup.step")),
+            "square_to_round": patterns.flatten(patterns.load(SAMPLES / "square_to_round.step"))}
+
+
+def _notch_lines(doc):
+    """(k, 2, 2): the NOTCH lines of a machine file (a V gives two)."""
+    return np.array([[np.array(e.dxf.start)[:2], np.array(e.dxf.end)[:2]]
+                     for e in doc.modelspace().query('LINE[layer=="NOTCH"]')]).reshape(-1, 2, 2)
+
+
+@pytest.mark.parametrize("allowance", [0.0, 10.0])
+@pytest.mark.parametrize("style", ["slit", "v"])
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+def test_every_notch_starts_on_the_cut_line_and_points_into_the_piece(notched, tmp_path, part, style, allowance):
+    """Each panel's notches, read back from the machine file, checked with shapely against its own cut
+    polygon (and seam polygon): one end on the cut line; the rest inside the cut outline, within the
+    seam allowance when there is one (never past the seam line into the finished piece), and never
+    running along the cut line."""
+    pattern = notched[part]
+    path = tmp_path / f"{part}.dxf"
+    pattern.to_dxf(path, seam_allowance=allowance, notch_style=style)
+    doc = read(path)
+    cuts = _polygons(doc, "CUT")
+    sews = _polygons(doc, "SEW") if allowance else cuts
+    lines = _notch_lines(doc)
+    n_notches = 2 * 2 * len(pattern.seams)  # both ends of both sides of every seam
+    assert len(lines) == n_notches * (1 if style == "slit" else 2)
+    for a, b in lines:
+        k = int(np.argmin([c.distance(shapely.Point((a + b) / 2)) for c in cuts]))
+        cut, sew = cuts[k], sews[int(np.argmin([s.distance(shapely.Point((a + b) / 2)) for s in sews]))]
+        on_cut = [cut.exterior.distance(shapely.Point(p)) < 1e-6 for p in (a, b)]
+        assert any(on_cut)
+        outer, inner = (a, b) if on_cut[0] else (b, a)
+        for t in (0.25, 0.5, 0.75):
+            q = shapely.Point(outer + t * (inner - outer))
+            assert cut.contains(q)  # into the piece's outline
+            assert cut.exterior.distance(q) > 1e-3  # not along the cut line
+            if allowance:
+                assert not sew.buffer(-1e-6).contains(q)  # not past the seam line
+
+
+@pytest.mark.parametrize("allowance", [0.0, 10.0])
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+def test_every_astm_notch_points_into_the_piece(notched, tmp_path, part, allowance):
+    pattern = notched[part]
+    path = tmp_path / f"{part}_astm.dxf"
+    pattern.to_dxf(path, profile="astm", seam_allowance=allowance)
+    doc = read(path)
+    count = 0
+    for insert in doc.modelspace().query("INSERT"):
+        block = doc.blocks[insert.dxf.name]
+        (cut,) = [e for e in block.query("POLYLINE") if e.dxf.layer == "1"]
+        cut_poly = shapely.Polygon([tuple(v.dxf.location)[:2] for v in cut.vertices])
+        for point in block.query('POINT[layer=="4"]'):
+            base = np.array(point.dxf.location)[:2]
+            depth = point.dxf.location.z
+            direction = np.array([np.cos(np.radians(point.dxf.angle)), np.sin(np.radians(point.dxf.angle))])
+            assert cut_poly.exterior.distance(shapely.Point(base)) < 1e-6
+            for t in (0.25, 0.5, 0.75):
+                q = shapely.Point(base + t * depth * direction)
+                assert cut_poly.contains(q) and cut_poly.exterior.distance(q) > 1e-3
+            count += 1
+    assert count == 2 * 2 * len(pattern.seams)
+
+
+@pytest.mark.parametrize("options", [{}, {"version": "R12"}, {"profile": "astm"}, {"seam_allowance": 10.0},
+                                     {"units": "in"}, {"units": "cm", "version": "R2018"}])
+def test_the_drawing_starts_in_the_first_quadrant(plate, tmp_path, options):
+    """A laser's work area and a page start at (0, 0): the extents start 5 mm from each axis."""
+    from ezdxf import bbox
+
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, **options)
+    box = bbox.extents(read(path).modelspace())
+    scale = patterns.Unit(options.get("units", "mm")).mm
+    assert (box.extmin.x * scale, box.extmin.y * scale) == pytest.approx((5.0, 5.0), abs=1e-6)
+
+
+@pytest.mark.parametrize("options", [{}, {"seam_allowance": 10.0}, {"version": "R12"}, {"profile": "astm"}])
+def test_straight_edges_are_one_segment(notched, tmp_path, options):
+    """The box's panels are rectangles: each cut line (and seam line) is four vertices, not the
+    hundreds of mesh points along its edges; ASTM has no curve points on them."""
+    pattern = notched["box"]
+    path = tmp_path / "box.dxf"
+    pattern.to_dxf(path, **options)
+    doc = read(path)
+    if options.get("profile") == "astm":
+        rings = [e for b in doc.blocks for e in b if e.dxftype() == "POLYLINE"]
+        assert [len(list(e.vertices)) for e in rings] == [4] * len(pattern.panels)
+        assert not [e for b in doc.blocks for e in b if e.dxftype() == "POINT" and e.dxf.layer == "3"]
+        return
+    for layer in ("CUT", "SEW") if options.get("seam_allowance") else ("CUT",):
+        assert [len(pts) for pts, _ in polylines(doc, layer)] == [4] * len(pattern.panels)
+        # ... and still the panels' true areas
+        areas = sorted(shapely.Polygon(pts).area for pts, _ in polylines(doc, layer))
+        if layer == "CUT" and not options.get("seam_allowance"):
+            assert areas == pytest.approx(sorted(p.area for p in pattern.panels), rel=1e-9)
+
+
+LABELLED = ["box", "cup.step", "duct_transition.step", "hopper.step", "hull_panel.step", "rolled_cylinder.step",
+            "square_to_round.step", "dish.obj", "cone.obj"]
+
+
+@pytest.fixture(scope="module")
+def labelled():
+    out = {}
+    for name in LABELLED:
+        source = bd.Box(200, 100, 50) if name == "box" else SAMPLES / name
+        out[name] = patterns.flatten(patterns.load(source))
+    return out
+
+
+@pytest.mark.parametrize("allowance", [0.0, 10.0])
+@pytest.mark.parametrize("name", LABELLED)
+def test_no_label_crosses_a_cut_line_or_another_label(labelled, tmp_path, name, allowance):
+    """Every TEXT of the machine file (names, strain, seam lengths, bend angles), boxed with ezdxf's
+    own font metrics for the standard style at its height and angle, read back: off every CUT and SEW
+    line, and off every other label."""
+    from patterns.export.labels import text_box
+
+    path = tmp_path / "p.dxf"
+    labelled[name].to_dxf(path, seam_allowance=allowance, bend_spacing=50.0)
+    doc = read(path)
+    lines = shapely.union_all([shapely.LinearRing(pts) for layer in ("CUT", "SEW")
+                               for pts, _ in polylines(doc, layer)])
+    boxes = [text_box(t.dxf.text, tuple(t.dxf.align_point)[:2], t.dxf.height, t.dxf.rotation, widen=1.0)
+             for t in doc.modelspace().query("TEXT")]
+    assert boxes
+    assert not [b for b in boxes if b.intersects(lines)]
+    tree = shapely.STRtree(boxes)
+    pairs = [(i, j) for i, j in zip(*tree.query(boxes, predicate="intersects")) if i < j]
+    assert not pairs

@@ -6,6 +6,7 @@ import ezdxf
 import numpy as np
 import pytest
 import shapely
+import shapely.affinity
 
 import patterns
 from patterns import surfaces  # noqa: F401  (patterns.surfaces below)
@@ -15,6 +16,7 @@ from patterns.measure import flat_direction
 from patterns.samples import cup, duct_transition, hopper, hull_panel
 
 from .conftest import SAMPLES
+from .helpers import drawing_shift
 
 
 @pytest.fixture(scope="module")
@@ -159,7 +161,9 @@ def test_squared_seam_allowance_corners(cup_pattern, tmp_path):
         laid.to_dxf(path, seam_allowance=10.0, seam_corners=corners)
         doc = ezdxf.readfile(path)
         cuts = [shapely.Polygon([q[:2] for q in e.get_points("xy")]) for e in doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')]
-        outlines[corners] = min(cuts, key=lambda c: c.bounds[0])  # panel 0
+        # panel 0, moved back by the file's own shift into the first quadrant
+        outlines[corners] = shapely.affinity.translate(min(cuts, key=lambda c: c.bounds[0]),
+                                                       *-drawing_shift(doc.modelspace(), laid, "SEW"))
     flat = laid.panels[0]
     seam_line = flat.uv[flat.loops[0]]
     for cut in outlines.values():

@@ -25,6 +25,7 @@ from ..options import Options, check_number, is_number, option
 from ..units import UNIT_NAMES, Unit
 from .arcs import fit_arcs
 from .heatmap import display_offsets
+from .labels import LabelPlacer, along
 
 __all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "PROFILES", "DxfOptions", "seam_label",
            "write_outline_dxf", "write_pattern_dxf"]
@@ -185,7 +186,7 @@ class _PanelGeometry:
             self.cut_loops = [np.asarray(cut.exterior.coords)[:-1]] + [np.asarray(r.coords)[:-1] for r in cut.interiors]
         else:
             self.cut_loops = self.seam_loops
-        self.cut_loops = [_snap(loop) for loop in self.cut_loops]
+        self.cut_loops = [_straight_runs(_snap(loop)) for loop in self.cut_loops]
         inside = shapely.get_coordinates(shapely.point_on_surface(polygon))[0]
         self.label_at = inside
         box = np.ptp(self.seam_loops[0], axis=0)
@@ -297,6 +298,17 @@ def _snap(loop: np.ndarray, tol: float = 1e-6) -> np.ndarray:
     return loop
 
 
+STRAIGHT = 0.001
+"""A point within this (mm) of the line through its neighbours is dropped: a straight run is one segment."""
+
+
+def _straight_runs(loop: np.ndarray, tolerance: float = STRAIGHT) -> np.ndarray:
+    """A closed loop (k, 2) with the points of its straight runs dropped (Douglas-Peucker within ``tolerance``)."""
+    simple = shapely.simplify(shapely.LinearRing(loop), tolerance, preserve_topology=True)
+    pts = np.asarray(simple.coords)[:-1]
+    return pts if len(pts) >= 3 else np.asarray(loop)
+
+
 def _allowance_lookup(seam_allowance, seam_ids, path):
     """A function ``seam id or None -> allowance, mm`` from a checked number or mapping (:class:`DxfOptions`)."""
     if not isinstance(seam_allowance, dict):
@@ -319,8 +331,9 @@ def _readable_angle(direction) -> float:
 
 
 def _seam_annotations(pattern, geo, unit: Unit = Unit.MM):
-    """``(text, position (2,), angle degrees)`` for every seam side on the panel, at its middle, inside."""
-
+    """``(text, [(place (2,), tangent (2,)), ...])`` for every seam side on the panel: the places its
+    label may go, along the seam (its middle first), 1.6 label heights inside the panel."""
+    flat = pattern.panels[geo.index]
     out = []
     for fs in pattern.seams:
         seam = fs.seam
@@ -328,15 +341,9 @@ def _seam_annotations(pattern, geo, unit: Unit = Unit.MM):
             if p != geo.index:
                 continue
             pts = geo.uv[idx]
-            mid = len(pts) // 2
-            a, b = pts[max(mid - 1, 0)], pts[min(mid + 1, len(pts) - 1)]
-            tangent = (b - a) / max(np.linalg.norm(b - a), 1e-12)
-            normal = np.array([-tangent[1], tangent[0]])
-            at = pts[mid] + 1.6 * geo.text_height * normal
-            if not shapely.contains_xy(geo.polygon, *at):
-                at = pts[mid] - 1.6 * geo.text_height * normal
-            text = seam_label(fs, side, unit)
-            out.append((text, at, _readable_angle(tangent)))
+            if _runs_along_loop(flat.loops, idx) < 0:
+                pts = pts[::-1]  # the panel to the left of the seam
+            out.append((seam_label(fs, side, unit), along(pts, 1.6 * 0.6 * geo.text_height)))
     return out
 
 
@@ -391,25 +398,79 @@ def notch_positions(flat_seam, side: int, uv: np.ndarray, spacing: float | None)
 
 
 def _notches(pattern, geo, allowance_of, spacing=None):
-    """``(point on the seam line, outward normal, depth, outward?)`` for every notch on the panel."""
+    """``(start on the cut line, inward direction, depth)`` of every notch on the panel, right by construction.
 
+    With a seam allowance, a notch runs from the cut line to the seam line, square
+    to the seam there: it starts where the ray from the seam point outwards (the
+    seam's own outward normal, taken from which side of it the panel lies, not
+    from a probe) meets the cut line, and ends on the seam point -- at a corner
+    as well, where it lies in the allowance of the edge beyond.  Without one,
+    the cut line is the seam line and the notch is a snip into the piece along the
+    outline's inward normal, the bisector of the two edges at a corner (never
+    along an edge).
+    """
+    flat = pattern.panels[geo.index]
+    cut = shapely.Polygon(geo.cut_loops[0], geo.cut_loops[1:])
     out = []
     for fs in pattern.seams:
         seam = fs.seam
         for side, p in enumerate(seam.panels):
             if p != geo.index:
                 continue
-            step = np.mean(np.linalg.norm(np.diff(geo.uv[seam.vertices[side]], axis=0), axis=1))
+            along = _runs_along_loop(flat.loops, seam.vertices[side])
+            depth = allowance_of(seam.id)
             for _, point, tangent in notch_positions(fs, side, geo.uv, spacing):
-                normal = np.array([tangent[1], -tangent[0]])
-                if shapely.contains_xy(geo.polygon, *(point + 0.5 * step * normal)):
-                    normal = -normal  # outward = away from the panel
-                depth = allowance_of(seam.id)
-                out.append((point, normal, depth if depth > 0 else 3.0, depth > 0))
+                inward = along * np.array([-tangent[1], tangent[0]])  # the panel lies to the left of its loops
+                out.append(_notch(cut, geo, point, inward, depth))
     depth = allowance_of(None)
-    for point, normal in _dart_mouths(pattern.panels[geo.index], geo, across=depth > 0):
-        out.append((point, normal, depth if depth > 0 else 3.0, depth > 0))
+    for point, normal in _dart_mouths(flat, geo, across=depth > 0):
+        out.append(_notch(cut, geo, point, -normal, depth))
     return out
+
+
+def _runs_along_loop(loops, vertices) -> float:
+    """+1 when a seam's vertices run the way its panel's boundary loop does (panel to their left), else -1."""
+    a, b = int(vertices[0]), int(vertices[1])
+    for loop in loops:
+        at = np.flatnonzero(np.asarray(loop) == a)
+        if len(at):
+            return 1.0 if int(loop[(at[0] + 1) % len(loop)]) == b else -1.0
+    return 1.0
+
+
+def _notch(cut, geo, point, inward, depth):
+    """One notch at a seam-line ``point`` whose inward normal is ``inward``: see :func:`_notches`."""
+    if depth > 0:
+        ray = shapely.LineString([point, point - 3.0 * depth * inward])
+        hits = shapely.get_coordinates(ray.intersection(cut.boundary))
+        if len(hits):
+            start = hits[np.argmin(np.linalg.norm(hits - point, axis=1))]
+            if np.linalg.norm(start - point) > 1e-9:
+                return start, inward, float(np.linalg.norm(start - point))
+        return point - depth * inward, inward, float(depth)
+    direction = inward
+    for loop in geo.cut_loops:  # at a corner of the outline: the bisector of its two edges' inward normals
+        k = np.flatnonzero(np.linalg.norm(loop - point, axis=1) < 1e-9)
+        if len(k):
+            i = int(k[0])
+            before, after = loop[i] - loop[i - 1], loop[(i + 1) % len(loop)] - loop[i]
+            normals = [np.array([-d[1], d[0]]) / max(np.linalg.norm(d), 1e-300) for d in (before, after)]
+            if normals[0] @ normals[1] < np.cos(np.radians(10)):
+                bisector = normals[0] + normals[1]
+                if np.linalg.norm(bisector) > 1e-9:
+                    direction = bisector / np.linalg.norm(bisector)
+                    if not shapely.contains_xy(cut, *(point + 0.5 * direction)):
+                        direction = -direction
+            break
+    return point, direction, 3.0
+
+
+def _v_mouth(geo, start, width) -> tuple:
+    """The two ends of a V notch's mouth: on the cut outline, half ``width`` along it either side of ``start``."""
+    rings = [shapely.LinearRing(loop) for loop in geo.cut_loops]
+    ring = rings[int(np.argmin([r.distance(shapely.Point(start)) for r in rings]))]
+    at = ring.project(shapely.Point(start))
+    return tuple(np.array(ring.interpolate((at + d) % ring.length).coords[0]) for d in (-0.5 * width, 0.5 * width))
 
 
 def _dart_mouths(flat, geo, *, across: bool) -> list:
@@ -471,14 +532,37 @@ def write_pattern_dxf(pattern, path, options: DxfOptions | None = None, **keywor
             for i in range(len(pattern.panels))]
     if opts.profile == "machine":
         doc = _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts)
+        _first_quadrant(doc, MARGIN / Unit(opts.units).mm)
         with atomic_output(path, what="DXF file") as tmp:
             _save(doc, tmp)
     else:
         from ezdxf.addons import gerber_D6673
 
         doc = _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts)
+        _first_quadrant(doc, MARGIN)
         with atomic_output(path, what="DXF file") as tmp:
             gerber_D6673.export_file(doc, tmp)
+
+
+MARGIN = 5.0
+"""Every drawing starts this far (mm) from the X and Y axes, in the first quadrant, where a cutter's
+work area and a page are."""
+
+
+def _first_quadrant(doc, margin: float) -> None:
+    """Move everything in model space so that the drawing's extents start at (margin, margin)."""
+    from ezdxf import bbox
+
+    box = bbox.extents(doc.modelspace(), fast=True)
+    if not box.has_data:
+        return
+    dx, dy = margin - box.extmin.x, margin - box.extmin.y
+    for entity in doc.modelspace():
+        if entity.dxftype() == "INSERT":  # an ASTM piece: its block's own geometry moves (readers that
+            for inner in doc.blocks[entity.dxf.name]:  # ignore insertion points still see it in place)
+                inner.translate(dx, dy, 0.0)
+        else:
+            entity.translate(dx, dy, 0.0)
 
 
 def _allowance_values(pattern, allowance_of):
@@ -531,39 +615,57 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
             poly(loop, "CUT")
         if g.has_allowance:
             for loop in g.seam_loops:
-                poly(loop, "SEW")
-        for point, normal, depth, outward in _notches(pattern, g, allowance_of, notch_spacing):
-            direction = normal if outward else -normal
+                poly(_straight_runs(loop), "SEW")
+        for start, inward, depth in _notches(pattern, g, allowance_of, notch_spacing):
+            tip = start + inward * depth  # on the seam line (or, with no allowance, a snip into the piece)
             if notch_style == "slit":
-                msp.add_line(tuple(point * scale), tuple((point + direction * depth) * scale),
-                             dxfattribs={"layer": "NOTCH"})
-            else:  # a V: its tip on the seam line, opening to the cut line, as wide as deep
-                side = np.array([-direction[1], direction[0]]) * 0.5 * depth
-                for arm in (side, -side):
-                    msp.add_line(tuple(point * scale), tuple((point + direction * depth + arm) * scale),
-                                 dxfattribs={"layer": "NOTCH"})
+                msp.add_line(tuple(start * scale), tuple(tip * scale), dxfattribs={"layer": "NOTCH"})
+            else:  # a V: its tip inside, opening on the cut line, as wide as deep
+                for end in _v_mouth(g, start, depth):
+                    msp.add_line(tuple(tip * scale), tuple(end * scale), dxfattribs={"layer": "NOTCH"})
         for tip in _drill_holes(pattern.panels[g.index], g):
             msp.add_point(tuple(tip * scale), dxfattribs={"layer": "DRILL"})
         a, b = _grain_line(g)
         msp.add_line(tuple(np.asarray(a) * scale), tuple(np.asarray(b) * scale), dxfattribs={"layer": "GRAIN"})
-        text(g.name, g.label_at + [0.0, 0.8 * g.text_height], 1.2 * g.text_height)
-        text(f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%",
-             g.label_at - [0.0, 0.9 * g.text_height], 0.7 * g.text_height)
-        for s, at, angle in _seam_annotations(pattern, g, unit):
-            text(s, at, 0.6 * g.text_height, angle)
-        if bend_spacing is not None:
-            for a, b, turn in pattern.panels[g.index].rulings(bend_spacing):
-                a, b = a + offsets[g.index], b + offsets[g.index]
-                msp.add_line(tuple(a * scale), tuple(b * scale), dxfattribs={"layer": "BEND"})
-                direction = (b - a) / max(np.linalg.norm(b - a), 1e-12)
-                text(f"BEND {turn:.2f} DEG", b - direction * 2.0 * g.text_height, 0.5 * g.text_height,
-                     _readable_angle(direction), layer="BEND")
+        rulings = [] if bend_spacing is None else [(a + offsets[g.index], b + offsets[g.index], turn) for a, b, turn
+                                                   in pattern.panels[g.index].rulings(bend_spacing)]
+        for a, b, _ in rulings:
+            msp.add_line(tuple(a * scale), tuple(b * scale), dxfattribs={"layer": "BEND"})
+        for label, layer in _machine_labels(pattern, g, unit, rulings):
+            text(label.text, label.at, label.height, label.angle, layer=layer)
         if strain_layer:
             _strain_solids(msp, pattern.panels[g.index], g.uv, scale, truecolor=version not in ("R12", "R2000"))
-    if r12:
-        text(f"UNITS: {unit.label}", [geos[0].box[0], geos[0].box[1] - 3 * geos[0].text_height],
-             geos[0].text_height)
+    if r12:  # above the whole drawing, clear of every piece
+        top = max(float(np.max(loop[:, 1])) for g in geos for loop in g.cut_loops)
+        left = min(float(np.min(loop[:, 0])) for g in geos for loop in g.cut_loops)
+        th = geos[0].text_height
+        msp.add_text(f"UNITS: {unit.label}", height=th * scale, dxfattribs={"layer": "LABEL"}).set_placement(
+            (left * scale, (top + th) * scale), align=ezdxf.enums.TextEntityAlignment.BOTTOM_LEFT)
     return doc
+
+
+def _machine_labels(pattern, g, unit, rulings) -> list:
+    """``(Label, layer)`` of one panel in the machine profile, each placed clear of the lines and the
+    others (:class:`~patterns.export.labels.LabelPlacer`): name and strain, each seam side's lengths,
+    each ruling's bend angle."""
+    placer = LabelPlacer(g.polygon)
+    th = g.text_height
+    strain = f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%"
+    out = [(label, "LABEL") for label in placer.place_block([(g.name, 0.8, 1.2), (strain, -0.9, 0.7)],
+                                                            placer.inside_places(g.label_at, th), th)]
+    for s, places in _seam_annotations(pattern, g, unit):
+        for place, tangent in places:
+            label = placer.place(s, [place], 0.6 * th, _readable_angle(tangent))
+            if label is not None:
+                out.append((label, "LABEL"))
+                break
+    for a, b, turn in rulings:
+        direction = (b - a) / max(np.linalg.norm(b - a), 1e-12)
+        places = [b - direction * f * np.linalg.norm(b - a) for f in (0.1, 0.3, 0.5, 0.7, 0.9)]
+        label = placer.place(f"BEND {turn:.2f} DEG", places, 0.5 * th, _readable_angle(direction))
+        if label is not None:
+            out.append((label, "BEND"))
+    return out
 
 
 def _save(doc, path) -> None:
@@ -658,12 +760,10 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
                 block.add_point((float(p[0]), float(p[1])), dxfattribs={"layer": "2" if t > np.radians(20) else "3"})
         if g.has_allowance:
             for loop in g.seam_loops:
-                block.add_polyline2d(loop.tolist(), close=True, dxfattribs={"layer": "14"})
-        for point, normal, depth, outward in _notches(pattern, g, allowance_of, notch_spacing):
+                block.add_polyline2d(_straight_runs(loop).tolist(), close=True, dxfattribs={"layer": "14"})
+        for base, inward, depth in _notches(pattern, g, allowance_of, notch_spacing):
             # ASTM notch: a POINT on the cut line; z = depth, group 50 = angle (into the
             # piece), group 39 = width for a V notch.
-            base = point + normal * depth if outward else point
-            inward = -normal
             angle = float(np.degrees(np.arctan2(inward[1], inward[0])))
             attribs = {"layer": "4", "angle": angle}
             if notch_style == "v":
@@ -676,16 +776,21 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
             for a, b, _ in pattern.panels[g.index].rulings(bend_spacing):
                 block.add_line(tuple(a + offsets[g.index]), tuple(b + offsets[g.index]), dxfattribs={"layer": "8"})
         th = g.text_height
+        placer = LabelPlacer(g.polygon)
         lines = [f"Piece Name:{g.name}", "Quantity:1", "Material:", f"Style Name:{pattern.name}", "Units:METRIC"]
-        for k, s in enumerate(lines):
-            block.add_text(s, height=0.6 * th, dxfattribs={"layer": "1"}).set_placement(
-                tuple(g.label_at + [0.0, (1.5 - k) * th]), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
-        block.add_text(f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%", height=0.6 * th,
-                       dxfattribs={"layer": "15"}).set_placement(
-            tuple(g.label_at - [0.0, 4.0 * th]), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
-        for s, at, angle in _seam_annotations(pattern, g):
-            block.add_text(s, height=0.6 * th, rotation=angle, dxfattribs={"layer": "15"}).set_placement(
-                tuple(at), align=ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER)
+        strain = f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%"
+        block_lines = [(s, 1.5 - k, 0.6) for k, s in enumerate(lines)] + [(strain, -4.0, 0.6)]
+        centre = ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER
+        for k, label in enumerate(placer.place_block(block_lines, placer.inside_places(g.label_at, th), th)):
+            block.add_text(label.text, height=label.height, dxfattribs={"layer": "1" if k < len(lines) else "15"}
+                           ).set_placement(tuple(label.at), align=centre)
+        for s, places in _seam_annotations(pattern, g):
+            for place, tangent in places:
+                label = placer.place(s, [place], 0.6 * th, _readable_angle(tangent))
+                if label is not None:
+                    block.add_text(s, height=label.height, rotation=label.angle, dxfattribs={"layer": "15"}
+                                   ).set_placement(tuple(label.at), align=centre)
+                    break
         msp.add_blockref(name, (0.0, 0.0), dxfattribs={"layer": "1"})
     return doc
 
