@@ -740,3 +740,14 @@ def test_no_label_crosses_a_cut_line_or_another_label(labelled, tmp_path, name, 
     tree = shapely.STRtree(boxes)
     pairs = [(i, j) for i, j in zip(*tree.query(boxes, predicate="intersects")) if i < j]
     assert not pairs
+
+
+@pytest.mark.parametrize("options", [{"version": "R12"}, {"version": "R12", "units": "in"}, {"profile": "astm"}])
+def test_r12_files_declare_their_units_too(plate, tmp_path, options):
+    """R12 predates $INSUNITS and $MEASUREMENT; they are written anyway (Inkscape scales by them)."""
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, **options)
+    doc = read(path)
+    unit = patterns.Unit(options.get("units", "mm"))
+    assert doc.dxfversion == "AC1009"
+    assert (doc.header["$INSUNITS"], doc.header["$MEASUREMENT"]) == (unit.insunits, unit.measurement)

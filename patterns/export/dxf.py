@@ -535,6 +535,8 @@ def write_pattern_dxf(pattern, path, options: DxfOptions | None = None, **keywor
         _first_quadrant(doc, MARGIN / Unit(opts.units).mm)
         with atomic_output(path, what="DXF file") as tmp:
             _save(doc, tmp)
+            if opts.version == "R12":
+                _r12_units(tmp, Unit(opts.units), doc.output_encoding)
     else:
         from ezdxf.addons import gerber_D6673
 
@@ -542,6 +544,7 @@ def write_pattern_dxf(pattern, path, options: DxfOptions | None = None, **keywor
         _first_quadrant(doc, MARGIN)
         with atomic_output(path, what="DXF file") as tmp:
             gerber_D6673.export_file(doc, tmp)
+            _r12_units(tmp, Unit.MM, doc.output_encoding)
 
 
 MARGIN = 5.0
@@ -686,6 +689,24 @@ def _save(doc, path) -> None:
     fixed = re.sub(r"(\d+\.\d+\.\d+) @ \d{4}-\d\d-\d\dT[\d:.]+\+00:00", r"\1 @ 2000-01-01T00:00:00+00:00", text)
     if fixed != text:
         path.write_text(fixed, encoding=doc.output_encoding, errors="surrogateescape")
+
+
+def _r12_units(path, unit: Unit, encoding: str) -> None:
+    """Write ``$INSUNITS`` and ``$MEASUREMENT`` into an R12 file's header as well.
+
+    DXF R12 predates both variables (ezdxf leaves them out), but readers that scale
+    by them -- Inkscape's "read from file" -- take a file without them for inches
+    and draw a millimetre drawing 25.4 times too large; R12 readers that do not
+    know them skip unknown header variables.  The unit is also in a text of every
+    file (``UNITS: MM``, ASTM ``Units:METRIC``)."""
+    path = Path(path)
+    text = path.read_text(encoding=encoding, errors="surrogateescape")
+    head = re.search(r"(?m)^\s*2\r?\nHEADER\r?\n", text)
+    if head is None:  # pragma: no cover - every file ezdxf writes has a header section
+        return
+    found = [f"  9\n$INSUNITS\n 70\n{unit.insunits}\n", f"  9\n$MEASUREMENT\n 70\n{unit.measurement}\n"]
+    path.write_text(text[:head.end()] + "".join(found) + text[head.end():], encoding=encoding,
+                    errors="surrogateescape")
 
 
 def _new_doc(ezdxf, version, units):
