@@ -165,12 +165,19 @@ def test_astm_profile_is_piece_blocks_for_garment_cad(cup, tmp_path):
     path = tmp_path / "cup_astm.dxf"
     cup.to_dxf(path, profile="astm", seam_allowance=10.0)
     text = path.read_text(encoding="ascii")
-    # What Gerber's parser wants: no handles, no layout blocks, an empty header.
+    # What Gerber's parser wants: no handles, no layout blocks; a header with only the units.
     assert "$MODEL_SPACE" not in text.upper() and "$PAPER_SPACE" not in text.upper()
     doc = read(path)
     assert doc.dxfversion == "AC1009"
     inserts = doc.modelspace().query("INSERT")
-    assert len(inserts) == len(doc.modelspace()) == 4
+    assert len(inserts) == 4
+    # The style's text in model space, the standard's version line first; every layer used declared.
+    style = [t.dxf.text for t in doc.modelspace().query("TEXT")]
+    assert style[0] == "ASTM/D6673/10" and style[1:2] == [f"Style Name:{cup.name}"]
+    assert re.fullmatch(r"Creation Date:\d\d-\d\d-\d{4}", style[2])
+    assert style[3:] == ["Author:patterns", "Sample Size:BASE", "Grading Rule Table:", "Units:METRIC"]
+    used = {e.dxf.layer for e in doc.modelspace()} | {e.dxf.layer for b in doc.blocks for e in b}
+    assert used <= {layer.dxf.name for layer in doc.layers}
     for insert, flat in zip(inserts, cup.panels):
         assert insert.dxf.layer == "1" and insert.dxf.name == flat.name
         block = doc.blocks[insert.dxf.name]
@@ -491,7 +498,7 @@ def test_astm_pieces_read_back_entity_by_entity(tmp_path):
         assert np.abs(np.sort(turns, axis=0) - np.sort(corners, axis=0)).max() < 1e-6
         assert len(turns) + len(curves) == len(cut_pts)  # every cut vertex is one or the other
         texts = by[("TEXT", "1")]
-        assert [t.dxf.text for t in texts] == [f"Piece Name:{name}", "Quantity:1", "Material:",
+        assert [t.dxf.text for t in texts] == [f"Piece Name:{name}", "Size:BASE", "Quantity:1", "Material:",
                                                f"Style Name:{pattern.name}", "Units:METRIC"]
         th = float(np.clip(0.03 * max(w, h), 2.0, 12.0))
         # 0.6 x the label height, or smaller where the piece is too narrow for the lines (the 50 mm
@@ -502,7 +509,7 @@ def test_astm_pieces_read_back_entity_by_entity(tmp_path):
         assert np.allclose(np.diff(ys), -size / 0.6)
         assert all(sew_poly.contains(shapely.Point(tuple(t.dxf.align_point)[:2])) for t in texts)
         (strain,) = [t for t in by[("TEXT", "15")] if t.dxf.text.startswith("STRAIN")]
-        assert strain.dxf.align_point[1] == pytest.approx(ys[0] - 5.5 * size / 0.6)  # 4 heights below their middle
+        assert strain.dxf.align_point[1] == pytest.approx(ys[0] - 7 * size / 0.6)  # 1.5 line heights below them
         assert strain.dxf.height == pytest.approx(size)
         (grain,) = by[("LINE", "7")]
         a, b = np.array(tuple(grain.dxf.start)[:2]), np.array(tuple(grain.dxf.end)[:2])

@@ -543,8 +543,7 @@ def write_pattern_dxf(pattern, path, options: DxfOptions | None = None, **keywor
         doc = _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts)
         _first_quadrant(doc, MARGIN)
         with atomic_output(path, what="DXF file") as tmp:
-            gerber_D6673.export_file(doc, tmp)
-            _r12_units(tmp, Unit.MM, doc.output_encoding)
+            _export_astm(gerber_D6673, doc, tmp)
 
 
 MARGIN = 5.0
@@ -691,6 +690,31 @@ def _save(doc, path) -> None:
         path.write_text(fixed, encoding=doc.output_encoding, errors="surrogateescape")
 
 
+def _export_astm(gerber_D6673, doc, path) -> None:
+    """Write an ASTM file as ezdxf's ``gerber_D6673`` add-on lays it out (no handles, only the piece
+    blocks, which Gerber's reader needs), its empty header replaced by one declaring the units and
+    followed by a TABLES section declaring every layer the pieces use."""
+    import io
+
+    from ezdxf.lldxf.tagwriter import TagWriter
+
+    stream = io.StringIO()
+    gerber_D6673.export_stream(doc, stream)
+    empty = "  0\nSECTION\n  2\nHEADER\n  0\nENDSEC\n"
+    text = stream.getvalue()
+    if not text.startswith(empty):  # pragma: no cover - the add-on's layout changed
+        raise RuntimeError("ezdxf's gerber_D6673 add-on no longer writes an empty header first")
+    tables = io.StringIO()
+    writer = TagWriter(tables, write_handles=False, dxfversion=doc.dxfversion)
+    tables.write("  0\nSECTION\n  2\nTABLES\n")
+    doc.tables.linetypes.export_dxf(writer)
+    doc.tables.layers.export_dxf(writer)
+    tables.write("  0\nENDSEC\n")
+    header = (f"  0\nSECTION\n  2\nHEADER\n  9\n$INSUNITS\n 70\n{Unit.MM.insunits}\n  9\n$MEASUREMENT\n 70\n"
+              f"{Unit.MM.measurement}\n  0\nENDSEC\n")
+    Path(path).write_text(header + tables.getvalue() + text[len(empty):], encoding="ascii", errors="dxfreplace")
+
+
 def _r12_units(path, unit: Unit, encoding: str) -> None:
     """Write ``$INSUNITS`` and ``$MEASUREMENT`` into an R12 file's header as well.
 
@@ -798,9 +822,10 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
                 block.add_line(tuple(a + offsets[g.index]), tuple(b + offsets[g.index]), dxfattribs={"layer": "8"})
         th = g.text_height
         placer = LabelPlacer(g.polygon)
-        lines = [f"Piece Name:{g.name}", "Quantity:1", "Material:", f"Style Name:{pattern.name}", "Units:METRIC"]
+        lines = [f"Piece Name:{g.name}", f"Size:{SAMPLE_SIZE}", "Quantity:1", "Material:", f"Style Name:{pattern.name}",
+                 "Units:METRIC"]
         strain = f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%"
-        block_lines = [(s, 1.5 - k, 0.6) for k, s in enumerate(lines)] + [(strain, -4.0, 0.6)]
+        block_lines = [(s, 2.0 - k, 0.6) for k, s in enumerate(lines)] + [(strain, -5.0, 0.6)]
         centre = ezdxf.enums.TextEntityAlignment.MIDDLE_CENTER
         for k, label in enumerate(placer.place_block(block_lines, placer.inside_places(g.label_at, th), th)):
             block.add_text(label.text, height=label.height, dxfattribs={"layer": "1" if k < len(lines) else "15"}
@@ -813,7 +838,35 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
                                    ).set_placement(tuple(label.at), align=centre)
                     break
         msp.add_blockref(name, (0.0, 0.0), dxfattribs={"layer": "1"})
+    # The style's own text, in model space above the pieces (ASTM D6673 / AAMA): which standard,
+    # style, date, author, sample size, grade rule table (none: one size) and units.
+    top = max(float(np.max(loop[:, 1])) for g in geos for loop in g.cut_loops)
+    left = min(float(np.min(loop[:, 0])) for g in geos for loop in g.cut_loops)
+    th = geos[0].text_height
+    style = [ASTM_VERSION, f"Style Name:{pattern.name}", f"Creation Date:{_creation_date()}", "Author:patterns",
+             f"Sample Size:{SAMPLE_SIZE}", "Grading Rule Table:", "Units:METRIC"]
+    for k, line in enumerate(style):  # the version line on top
+        msp.add_text(line, height=0.6 * th, dxfattribs={"layer": "1"}).set_placement(
+            (left, top + th * (len(style) - k)), align=ezdxf.enums.TextEntityAlignment.BOTTOM_LEFT)
     return doc
+
+
+ASTM_VERSION = "ASTM/D6673/10"
+"""The standard's version line, first of the style text."""
+
+SAMPLE_SIZE = "BASE"
+"""The one size a flattened pattern is (no grading): the piece text's ``Size:`` and the style's sample size."""
+
+
+def _creation_date() -> str:
+    """Today (UTC) as MM-DD-YYYY, or the day of ``SOURCE_DATE_EPOCH`` when set (reproducible builds)."""
+    import datetime
+    import os
+
+    epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    when = (datetime.datetime.fromtimestamp(int(epoch), tz=datetime.timezone.utc) if epoch and epoch.isdigit()
+            else datetime.datetime.now(tz=datetime.timezone.utc))
+    return when.strftime("%m-%d-%Y")
 
 
 def _block_name(name: str, used: set) -> str:
