@@ -14,6 +14,7 @@ import ezdxf
 import numpy as np
 import pytest
 import shapely
+import shapely.affinity
 from ezdxf import recover
 
 import patterns
@@ -176,7 +177,7 @@ def test_astm_profile_is_piece_blocks_for_garment_cad(cup, tmp_path):
     assert style[0] == "ASTM/D6673/10" and style[1:2] == [f"Style Name:{cup.name}"]
     assert re.fullmatch(r"Creation Date:\d\d-\d\d-\d{4}", style[2])
     assert style[3:] == ["Author:patterns", "Sample Size:BASE", "Grading Rule Table:", "Units:METRIC"]
-    used = {e.dxf.layer for e in doc.modelspace()} | {e.dxf.layer for b in doc.blocks for e in b}
+    used = {e.dxf.layer for e in doc.modelspace()} | {e.dxf.layer for b in doc.blocks if not b.is_any_layout for e in b}
     assert used <= {layer.dxf.name for layer in doc.layers}
     for insert, flat in zip(inserts, cup.panels):
         assert insert.dxf.layer == "1" and insert.dxf.name == flat.name
@@ -758,3 +759,34 @@ def test_r12_files_declare_their_units_too(plate, tmp_path, options):
     unit = patterns.Unit(options.get("units", "mm"))
     assert doc.dxfversion == "AC1009"
     assert (doc.header["$INSUNITS"], doc.header["$MEASUREMENT"]) == (unit.insunits, unit.measurement)
+
+
+@pytest.mark.parametrize("name", LABELLED)
+def test_no_astm_label_crosses_a_line_or_another_label(labelled, tmp_path, name):
+    """The same for the ASTM profile: the piece text, strain and seam lengths inside each piece block
+    and the style text in model space, off the cut and sew lines (layers 1, 14) and off each other."""
+    from patterns.export.labels import text_box
+
+    path = tmp_path / "p.dxf"
+    labelled[name].to_dxf(path, profile="astm", seam_allowance=10.0)
+    doc = read(path)
+    entities = list(doc.modelspace()) + [e for b in doc.blocks if not b.is_any_layout for e in b]
+    lines = shapely.union_all([shapely.LinearRing([tuple(v.dxf.location)[:2] for v in e.vertices])
+                               for e in entities if e.dxftype() == "POLYLINE" and e.dxf.layer in ("1", "14")])
+    boxes = [_text_box_read_back(t, text_box) for t in entities if t.dxftype() == "TEXT"]
+    assert not [b for b in boxes if b.intersects(lines)]
+    tree = shapely.STRtree(boxes)
+    assert not [(i, j) for i, j in zip(*tree.query(boxes, predicate="intersects")) if i < j]
+
+
+def _text_box_read_back(t, text_box):
+    """The box of a TEXT read back, from its alignment: centred boxes as written, bottom-left ones (the
+    ASTM style text; unrotated) moved so that their lower-left corner is the alignment point."""
+    h = t.dxf.height
+    if (t.dxf.halign, t.dxf.valign) == (1, 2):  # MIDDLE_CENTER
+        return text_box(t.dxf.text, tuple(t.dxf.align_point)[:2], h, t.dxf.rotation, widen=1.0)
+    assert (t.dxf.halign, t.dxf.valign) == (0, 1) and t.dxf.rotation == 0  # BOTTOM_LEFT
+    box = text_box(t.dxf.text, (0.0, 0.0), h, 0.0, widen=1.0)
+    x0, y0, _, _ = box.bounds
+    at = tuple(t.dxf.align_point)[:2]
+    return shapely.affinity.translate(box, at[0] - x0, at[1] - y0)
