@@ -80,6 +80,9 @@ def test_cone_frustum_blank_is_the_analytic_annular_sector(hopper, tmp_path, arc
     path = tmp_path / "hopper.dxf"
     hopper.to_dxf(path, arcs=arcs)
     (contour, segments), = dxf_cut_contours(path)
+    # The file holds the drawing moved into the first quadrant: move it back by the same shift
+    # (lower-left corners of the contour and of the flattened outline; the arcs' sag < 0.01 mm).
+    contour = contour - (contour.min(axis=0) - flat.uv[flat.loops[0]].min(axis=0))
     # The blank from the drawing: radii R/sin a about the apex, angle 2 pi sin a.
     s_in, s_out = R1 / SIN_A, R2 / SIN_A
     t0 = float(np.min(np.unwrap(np.arctan2(contour[:, 1], contour[:, 0]))))

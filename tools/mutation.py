@@ -105,6 +105,8 @@ def main(argv=None) -> int:
     parser.add_argument("--only", nargs="+", default=(), metavar="PATTERN",
                         help="run only the mutants whose names match (fnmatch), e.g. 'patterns.export.dxf.x__notches__*'")
     parser.add_argument("--max-children", type=int, default=None, help="test processes at once (default: mutmut's)")
+    parser.add_argument("--tests", nargs="+", default=None, metavar="TEST",
+                        help="the tests that answer for the mutants (default: the module's, as listed in MODULES)")
     args = parser.parse_args(argv)
     python = _venv()
     total_k = total_s = 0
@@ -112,7 +114,8 @@ def main(argv=None) -> int:
     print("| module | mutants | killed (timeouts included) | survived | score |")
     print("|---|---|---|---|---|", flush=True)
     for module in args.modules:
-        r = run(module, MODULES.get(module, ["tests/"]), python, only=args.only, max_children=args.max_children)
+        tests = args.tests or MODULES.get(module, ["tests/"])
+        r = run(module, tests, python, only=args.only, max_children=args.max_children)
         killed = r["killed"] + r["timeout"]
         total_k, total_s = total_k + killed, total_s + r["survived"]
         score = killed / max(killed + r["survived"], 1)
