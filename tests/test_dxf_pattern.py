@@ -268,7 +268,8 @@ def test_failed_export_leaves_no_file(cup, tmp_path):
 # --------------------------------------------------------------------------- #
 
 
-PACKAGES = {"librecad": "librecad", "dxf2gcode": "dxf2gcode", "freecadcmd": "freecad"}
+PACKAGES = {"librecad": "librecad", "dxf2gcode": "dxf2gcode", "freecadcmd": "freecad", "openscad": "openscad",
+            "inkscape": "inkscape"}
 """Each reader's command and the Debian package .ci/run installs it from."""
 
 
@@ -790,3 +791,108 @@ def _text_box_read_back(t, text_box):
     x0, y0, _, _ = box.bounds
     at = tuple(t.dxf.align_point)[:2]
     return shapely.affinity.translate(box, at[0] - x0, at[1] - y0)
+
+
+# --------------------------------------------------------------------------- #
+# OpenSCAD and Inkscape (issue 20): true size, or the reader table says why not
+# --------------------------------------------------------------------------- #
+
+PX = 25.4 / 96.0
+"""Inkscape's SVG user unit (a CSS pixel), mm."""
+
+
+def _inkscape_svg(path, tmp_path, scalemethod="file"):
+    """Inkscape's own DXF import (its ``dxf_input`` extension, run headless with the system's Python)."""
+    ext = Path("/usr/share/inkscape/extensions/dxf_input.py")
+    if shutil.which("inkscape") is None or not ext.exists():
+        if "inkscape" in _installed_by_ci():
+            pytest.fail("inkscape is missing although .ci/run installed it")
+        pytest.skip("inkscape is not installed (.ci/run installs it with apt-get)")
+    proc = subprocess.run(["/usr/bin/python3", str(ext), f"--scalemethod={scalemethod}", str(path)],
+                          capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ext.parent)),
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    svg = tmp_path / (path.stem + ".svg")
+    svg.write_text(proc.stdout)
+    return svg
+
+
+def _cut_area(doc):
+    return sum(p.area for p in _polygons(doc, "CUT"))
+
+
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+@pytest.mark.parametrize("options", [{}, {"version": "R12"}, {"units": "in"}, {"seam_allowance": 10.0}])
+def test_inkscape_reads_the_machine_profile_at_true_size(notched, tmp_path, part, options):
+    """Inkscape's DXF import, scaling "read from file" ($MEASUREMENT): every CUT ring at its area."""
+    from .readers.svg_rings import rings
+
+    path = tmp_path / f"{part}.dxf"
+    notched[part].to_dxf(path, **options)
+    svg = _inkscape_svg(path, tmp_path)
+    found = sorted(shapely.Polygon(r).area * PX**2 for r in rings(svg, "CUT"))
+    scale = patterns.Unit(options.get("units", "mm")).mm
+    expected = sorted(p.area * scale**2 for p in _polygons(read(path), "CUT"))
+    assert found == pytest.approx(expected, rel=1e-3)
+
+
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+def test_inkscape_reads_the_astm_profile_at_true_size(notched, tmp_path, part):
+    from .readers.svg_rings import symbol_rings
+
+    path = tmp_path / f"{part}_astm.dxf"
+    notched[part].to_dxf(path, profile="astm", seam_allowance=10.0)
+    svg = _inkscape_svg(path, tmp_path)
+    doc = read(path)
+    for name, ents in _block_entities(doc).items():
+        (cut,) = [e for e in ents if e.dxftype() == "POLYLINE" and e.dxf.layer == "1"]
+        area = shapely.Polygon([tuple(v.dxf.location)[:2] for v in cut.vertices]).area
+        biggest = max(shapely.Polygon(r).area for r in symbol_rings(svg)[name]) * PX**2
+        assert biggest == pytest.approx(area, rel=1e-3)
+
+
+def test_inkscape_takes_a_cm_file_for_mm(plate, tmp_path):
+    """The reader table's caveat, measured: Inkscape's "read from file" knows only $MEASUREMENT
+    (metric or imperial), so a drawing in cm comes in 10 times too small."""
+    from .readers.svg_rings import rings
+
+    path = tmp_path / "plate_cm.dxf"
+    plate.to_dxf(path, units="cm")
+    svg = _inkscape_svg(path, tmp_path)
+    found = sum(shapely.Polygon(r).area for r in rings(svg, "CUT")) * PX**2
+    assert found == pytest.approx(_cut_area(read(path)), rel=1e-3)  # the numbers as mm: 1/100 of the area
+
+
+def _openscad_svg(path, tmp_path, layer):
+    if shutil.which("openscad") is None:
+        if "openscad" in _installed_by_ci():
+            pytest.fail("openscad is missing although .ci/run installed it")
+        pytest.skip("openscad is not installed (.ci/run installs it with apt-get)")
+    scad, svg = tmp_path / "import.scad", tmp_path / "import.svg"
+    scad.write_text(f'import("{path}", layer="{layer}");\n')
+    proc = subprocess.run(["openscad", "-o", str(svg), str(scad)], capture_output=True, text=True, timeout=300)
+    return proc, svg
+
+
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+def test_openscad_imports_the_machine_profile_at_true_size(notched, tmp_path, part):
+    """OpenSCAD's import() of the CUT layer (R2000): the union of what it read has the panels' area."""
+    from .readers.svg_rings import rings
+
+    path = tmp_path / f"{part}.dxf"
+    notched[part].to_dxf(path)
+    proc, svg = _openscad_svg(path, tmp_path, "CUT")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    union = shapely.union_all([shapely.Polygon(r) for r in rings(svg)])
+    assert union.area == pytest.approx(_cut_area(read(path)), rel=1e-3)
+
+
+@pytest.mark.parametrize("options", [{"version": "R12"}, {"profile": "astm"}])
+def test_openscad_cannot_import_polylines(plate, tmp_path, options):
+    """The reader table's caveat, measured: OpenSCAD 2021.01 has no POLYLINE, the only polyline R12 and
+    ASTM D6673 have, so it imports nothing from them (it names the entity it skips)."""
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, **options)
+    proc, svg = _openscad_svg(path, tmp_path, "1" if options.get("profile") == "astm" else "CUT")
+    assert "Unsupported DXF Entity 'POLYLINE'" in proc.stderr or "Unsupported DXF Entity 'INSERT'" in proc.stderr
+    assert not svg.exists()  # "not a 2D object": nothing to export
