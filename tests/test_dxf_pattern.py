@@ -896,3 +896,41 @@ def test_openscad_cannot_import_polylines(plate, tmp_path, options):
     proc, svg = _openscad_svg(path, tmp_path, "1" if options.get("profile") == "astm" else "CUT")
     assert "Unsupported DXF Entity 'POLYLINE'" in proc.stderr or "Unsupported DXF Entity 'INSERT'" in proc.stderr
     assert not svg.exists()  # "not a 2D object": nothing to export
+
+
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+@pytest.mark.parametrize("options", [{"version": "R12"}, {"profile": "astm"}])
+def test_freecad_reads_r12_and_astm_at_true_size(notched, tmp_path, part, options):
+    """FreeCAD's importer chains each piece's cut line into a closed wire at the panel's area and
+    length (ASTM: the piece blocks exploded into one object)."""
+    _need("freecadcmd")
+    path = tmp_path / f"{part}.dxf"
+    pattern = notched[part]
+    pattern.to_dxf(path, **options)
+    proc = subprocess.run(["freecadcmd", str(READERS / "freecad_layers.py")], capture_output=True, text=True,
+                          env=dict(_qt_env(tmp_path), DXF=str(path)), timeout=300)
+    lines = [x for x in proc.stdout.splitlines() if "RESULT " in x]
+    assert lines, proc.stdout[-2000:] + proc.stderr[-2000:]
+    layers = json.loads(lines[-1].split("RESULT ", 1)[1])
+    if options.get("profile") == "astm":  # one object: the cut lines, and the zero-area notch and point marks
+        wires = [w for layer in layers.values() for w in layer["closed_wires"] if w["area"] > 1e-6]
+    else:
+        wires = layers["CUT"]["closed_wires"]
+    found = sorted((w["area"], w["length"]) for w in wires)
+    expected = sorted(ring_numbers(flat.uv[loop]) for flat in pattern.panels for loop in flat.loops)
+    assert len(found) == len(expected)
+    np.testing.assert_allclose(found, expected, rtol=1e-6)
+
+
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+def test_dxf2gcode_finds_each_astm_piece_closed(notched, tmp_path, part):
+    _need("dxf2gcode")
+    path = tmp_path / f"{part}_astm.dxf"
+    notched[part].to_dxf(path, profile="astm", seam_allowance=10.0)
+    proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
+                          capture_output=True, text=True, env=_qt_env(tmp_path), timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    found = json.loads(proc.stdout.strip().splitlines()[-1])
+    pieces = {name: layers for name, layers in found["blocks"].items() if not name.startswith("$")}
+    assert sorted(pieces) == sorted(flat.name for flat in notched[part].panels)
+    assert all(layers["1"] == {"contours": 1, "closed": 1} for layers in pieces.values())
