@@ -934,3 +934,39 @@ def test_dxf2gcode_finds_each_astm_piece_closed(notched, tmp_path, part):
     pieces = {name: layers for name, layers in found["blocks"].items() if not name.startswith("$")}
     assert sorted(pieces) == sorted(flat.name for flat in notched[part].panels)
     assert all(layers["1"] == {"contours": 1, "closed": 1} for layers in pieces.values())
+
+
+@pytest.mark.parametrize(("part", "allowance"), [
+    ("box", 0.0), ("box", 10.0), ("box", "per seam"), ("square_to_round", 0.0), ("square_to_round", 10.0),
+    pytest.param("square_to_round", "per seam", marks=pytest.mark.xfail(strict=True, reason=(
+        "known: where the allowance steps at the sharp corner of a triangle panel, the corner notch runs along "
+        "the step of the cut line (not into the piece, but no mark either)")))])
+def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance):
+    """Notches every 40 mm of seam (not only at the ends, where the outline has corners), and with an
+    allowance that changes from seam to seam (5 mm, 15 mm along the longest): each starts on the cut
+    line and runs into the piece, square to its seam, within the allowance."""
+    pattern = notched[part]
+    if allowance == "per seam":
+        longest = max(pattern.seams, key=lambda fs: fs.length).seam.id
+        allowance = {None: 5.0, longest: 15.0}
+    path = tmp_path / f"{part}.dxf"
+    pattern.to_dxf(path, seam_allowance=allowance, notch_spacing=40.0)
+    doc = read(path)
+    cuts = _polygons(doc, "CUT")
+    sews = _polygons(doc, "SEW") if allowance else cuts
+    lines = _notch_lines(doc)
+    assert len(lines) > 4 * len(pattern.seams)  # more than the ends
+    for a, b in lines:
+        mid = shapely.Point((a + b) / 2)
+        cut = cuts[int(np.argmin([c.distance(mid) for c in cuts]))]
+        sew = sews[int(np.argmin([s.distance(mid) for s in sews]))]
+        on_cut = [cut.exterior.distance(shapely.Point(p)) < 1e-6 for p in (a, b)]
+        assert any(on_cut)
+        outer, inner = (a, b) if on_cut[0] else (b, a)
+        if allowance:  # ends on the seam line (as drawn: its straight runs one segment within 0.001 mm)
+            assert sew.exterior.distance(shapely.Point(inner)) < 1e-3
+        for t in (0.25, 0.5, 0.75):
+            q = shapely.Point(outer + t * (inner - outer))
+            assert cut.contains(q) and cut.exterior.distance(q) > 1e-3
+            if allowance:
+                assert not sew.buffer(-1e-6).contains(q)

@@ -441,13 +441,22 @@ def _runs_along_loop(loops, vertices) -> float:
 def _notch(cut, geo, point, inward, depth):
     """One notch at a seam-line ``point`` whose inward normal is ``inward``: see :func:`_notches`."""
     if depth > 0:
-        ray = shapely.LineString([point, point - 3.0 * depth * inward])
-        hits = shapely.get_coordinates(ray.intersection(cut.boundary))
-        if len(hits):
-            start = hits[np.argmin(np.linalg.norm(hits - point, axis=1))]
-            if np.linalg.norm(start - point) > 1e-9:
-                return start, inward, float(np.linalg.norm(start - point))
+        # Where the allowance steps from one seam to the next, the step of the cut line runs along
+        # the ray from the seam's end: the notch moves half a millimetre along its own seam.
+        along = np.array([inward[1], -inward[0]])
+        for at in (point, point + 0.5 * along, point - 0.5 * along):
+            ray = shapely.LineString([at, at - 3.0 * depth * inward])
+            meet = ray.intersection(cut.boundary)
+            hits = shapely.get_coordinates(meet)
+            if len(hits) and shapely.get_type_id(meet) in (0, 4):  # points, not a run along the cut line
+                start = hits[np.argmin(np.linalg.norm(hits - at, axis=1))]
+                gap = float(np.linalg.norm(start - at))
+                if abs(gap - depth) < 1e-6 or (at is point and gap > 1e-9):
+                    return start, inward, gap
         return point - depth * inward, inward, float(depth)
+    rings = [shapely.LinearRing(loop) for loop in geo.cut_loops]  # straight runs dropped within 0.001 mm:
+    ring = rings[int(np.argmin([r.distance(shapely.Point(point)) for r in rings]))]  # start on the line drawn
+    point = np.array(ring.interpolate(ring.project(shapely.Point(point))).coords[0])
     direction = inward
     for loop in geo.cut_loops:  # at a corner of the outline: the bisector of its two edges' inward normals
         k = np.flatnonzero(np.linalg.norm(loop - point, axis=1) < 1e-9)
