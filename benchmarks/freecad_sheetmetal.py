@@ -94,14 +94,14 @@ def main(argv=None) -> int:
     import ezdxf
 
     commit = subprocess.run(["git", "-C", str(args.workbench), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
+                            text=True, check=False).stdout.strip()
     args.out.mkdir(parents=True, exist_ok=True)
     for step in sorted(SHEETMETAL.glob("*.STEP")):
         with tempfile.TemporaryDirectory() as tmp:
             script = Path(tmp) / "unfold.py"
             script.write_text(f"WORKBENCH = {str(args.workbench)!r}\nSTEP = {str(step)!r}\nK = {args.k_factor!r}\n"
                               + INSIDE_FREECAD)
-            proc = subprocess.run(["freecadcmd", str(script)], capture_output=True, text=True, timeout=600,
+            proc = subprocess.run(["freecadcmd", str(script)], capture_output=True, text=True, timeout=600, check=False,
                                   env={"QT_QPA_PLATFORM": "offscreen", "HOME": tmp, "PATH": "/usr/bin:/bin"})
         found = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
         result = json.loads(found[-1][7:]) if found else {"ok": False, "error": proc.stderr[-500:]}
