@@ -316,15 +316,12 @@ def _inflate(stream: bytes) -> bytes:
 
 @pytest.mark.parametrize("version", ["R12", "R2000"])
 def test_dxf2gcode_finds_one_closed_contour_per_cut_loop(plate, tmp_path, version):
-    _need("dxf2gcode")
+    """Holes too: the plate's cut loops (outlines and the hole's) each one closed contour."""
     path = tmp_path / "plate.dxf"
     plate.to_dxf(path, version=version, seam_allowance=5.0)
-    proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
-                          capture_output=True, text=True, env=_qt_env(tmp_path), timeout=120)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    found = json.loads(proc.stdout.strip().splitlines()[-1])
+    found = _dxf2gcode(path, tmp_path)
     n_loops = len(polylines(read(path), "CUT"))
-    assert found["entities"]["CUT"] == {"contours": n_loops, "closed": n_loops}
+    assert found["entities"]["CUT"]["contours"] == found["entities"]["CUT"]["closed"] == n_loops
     assert found["metric"] is True
 
 
@@ -923,24 +920,94 @@ def test_freecad_reads_r12_and_astm_at_true_size(notched, tmp_path, part, option
 
 
 @pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+@pytest.mark.parametrize("options", [{}, {"version": "R12"}, {"units": "in"},
+                                     {"profile": "astm", "seam_allowance": 10.0}])
+def test_librecad_prints_at_true_size(notched, tmp_path, part, options):
+    """LibreCAD's ``dxf2pdf --scale 1`` (1:1 on paper): the red CUT lines it strokes close into the
+    cut outlines, each at its area within 0.1 % (LibreCAD rounds every point to its 1200 dpi grid,
+    0.02 mm: 0.03-0.06 % of these areas); an inch file prints in inches (1 unit = 25.4 mm on paper).
+    ASTM pieces (blocks, every layer black): the outer rings of what it draws are the cut outlines."""
+    from .readers.pdf_paths import segments
+
+    _need("librecad")
+    path = tmp_path / f"{part}.dxf"
+    notched[part].to_dxf(path, **options)
+    proc = subprocess.run(["librecad", "dxf2pdf", "--scale", "1", str(path)], capture_output=True, text=True,
+                          env=_qt_env(tmp_path), timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    drawn = segments(path.with_suffix(".pdf"))
+    scale = patterns.Unit(options.get("units", "mm")).mm
+    if options.get("profile") == "astm":
+        lines = np.concatenate(list(drawn.values()))
+        faces = shapely.union_all(list(shapely.polygonize([shapely.LineString(s) for s in lines]).geoms))
+        rings = [shapely.Polygon(g.exterior) for g in getattr(faces, "geoms", [faces])]
+        expected = []
+        for ents in _block_entities(read(path)).values():
+            (cut,) = [e for e in ents if e.dxftype() == "POLYLINE" and e.dxf.layer == "1"]
+            expected.append(shapely.Polygon([tuple(v.dxf.location)[:2] for v in cut.vertices]))
+    else:
+        red = drawn[(1.0, 0.0, 0.0)]  # ACI 1, the CUT layer's colour
+        rings = list(shapely.polygonize([shapely.LineString(s) for s in red]).geoms)
+        expected = [shapely.affinity.scale(p, scale, scale, origin=(0, 0)) for p in _polygons(read(path), "CUT")]
+    found = sorted(rings, key=lambda g: g.area)
+    expected = sorted(expected, key=lambda g: g.area)
+    assert len(found) == len(expected)
+    for got, want in zip(found, expected):
+        assert got.area == pytest.approx(want.area, rel=1e-3)
+
+
+def _dxf2gcode(path, tmp_path):
+    _need("dxf2gcode")
+    proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
+                          capture_output=True, text=True, env=_qt_env(tmp_path), timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+@pytest.mark.parametrize("options", [{}, {"version": "R12"}, {"units": "in"}, {"seam_allowance": 10.0}])
+def test_dxf2gcode_reads_the_machine_profile_at_true_size(notched, tmp_path, part, options):
+    """dxf2gcode's reader: each CUT contour closed, at the area of the ring ezdxf reads back (in the
+    file's unit), and the unit taken from the header: metric for mm, imperial for inches."""
+    path = tmp_path / f"{part}.dxf"
+    notched[part].to_dxf(path, **options)
+    found = _dxf2gcode(path, tmp_path)
+    expected = sorted(p.area for p in _polygons(read(path), "CUT"))
+    assert found["entities"]["CUT"]["closed"] == found["entities"]["CUT"]["contours"] == len(expected)
+    np.testing.assert_allclose(found["entities"]["CUT"]["areas"], expected, rtol=1e-3)
+    assert found["metric"] is (options.get("units", "mm") != "in")
+
+
+def test_dxf2gcode_takes_a_cm_file_for_mm(plate, tmp_path):
+    """The reader table's caveat, measured: dxf2gcode knows inches ($INSUNITS 1) and millimetres
+    ($INSUNITS 4), and takes any other metric file ($MEASUREMENT 1) for millimetres."""
+    path = tmp_path / "plate_cm.dxf"
+    plate.to_dxf(path, units="cm")
+    found = _dxf2gcode(path, tmp_path)
+    assert found["metric"] is True  # read as mm: 1/10 of the size
+    np.testing.assert_allclose(found["entities"]["CUT"]["areas"], sorted(p.area for p in _polygons(read(path), "CUT")),
+                               rtol=1e-3)
+
+
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
 def test_dxf2gcode_finds_each_astm_piece_closed(notched, tmp_path, part):
     _need("dxf2gcode")
     path = tmp_path / f"{part}_astm.dxf"
     notched[part].to_dxf(path, profile="astm", seam_allowance=10.0)
-    proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
-                          capture_output=True, text=True, env=_qt_env(tmp_path), timeout=120)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    found = json.loads(proc.stdout.strip().splitlines()[-1])
+    found = _dxf2gcode(path, tmp_path)
     pieces = {name: layers for name, layers in found["blocks"].items() if not name.startswith("$")}
     assert sorted(pieces) == sorted(flat.name for flat in notched[part].panels)
-    assert all(layers["1"] == {"contours": 1, "closed": 1} for layers in pieces.values())
+    cut_lines = {name: ents for name, ents in _block_entities(read(path)).items()}
+    for name, layers in pieces.items():
+        assert layers["1"]["contours"] == layers["1"]["closed"] == 1
+        (cut,) = [e for e in cut_lines[name] if e.dxftype() == "POLYLINE" and e.dxf.layer == "1"]
+        area = shapely.Polygon([tuple(v.dxf.location)[:2] for v in cut.vertices]).area
+        assert layers["1"]["areas"][0] == pytest.approx(area, rel=1e-3)  # true size
 
 
 @pytest.mark.parametrize(("part", "allowance"), [
     ("box", 0.0), ("box", 10.0), ("box", "per seam"), ("square_to_round", 0.0), ("square_to_round", 10.0),
-    pytest.param("square_to_round", "per seam", marks=pytest.mark.xfail(strict=True, reason=(
-        "known: where the allowance steps at the sharp corner of a triangle panel, the corner notch runs along "
-        "the step of the cut line (not into the piece, but no mark either)")))])
+    ("square_to_round", "per seam")])
 def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance):
     """Notches every 40 mm of seam (not only at the ends, where the outline has corners), and with an
     allowance that changes from seam to seam (5 mm, 15 mm along the longest): each starts on the cut

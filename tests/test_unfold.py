@@ -20,6 +20,7 @@ import build123d as bd
 import ezdxf
 import numpy as np
 import pytest
+import shapely
 from scipy.spatial import cKDTree
 
 import patterns
@@ -288,7 +289,12 @@ def test_dxf2gcode_reads_closed_contours(strip_blank, tmp_path):
                           capture_output=True, text=True, env=env, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     found = json.loads(proc.stdout.strip().splitlines()[-1])
-    assert found["entities"]["CUT"] == {"contours": 2, "closed": 2}
+    assert found["entities"]["CUT"]["contours"] == found["entities"]["CUT"]["closed"] == 2
+    # the outline at its area and the hole (a CIRCLE) at pi r^2, as dxf2gcode holds them
+    outer, hole = strip_blank.polygon.exterior, strip_blank.polygon.interiors[0]
+    expected = sorted([np.pi * 4.0**2, shapely.Polygon(outer).area])
+    np.testing.assert_allclose(found["entities"]["CUT"]["areas"], expected, rtol=1e-3)
+    assert shapely.Polygon(hole).area == pytest.approx(np.pi * 4.0**2, rel=1e-3)
     assert found["metric"] is True
 
 

@@ -451,7 +451,9 @@ def _notch(cut, geo, point, inward, depth):
             if len(hits) and shapely.get_type_id(meet) in (0, 4):  # points, not a run along the cut line
                 start = hits[np.argmin(np.linalg.norm(hits - at, axis=1))]
                 gap = float(np.linalg.norm(start - at))
-                if abs(gap - depth) < 1e-6 or (at is point and gap > 1e-9):
+                inside = shapely.points(start + np.linspace(0.1, 0.9, 9)[:, None] * (at - start))
+                along_cut = shapely.distance(cut.boundary, inside).min() < 1e-3  # partly on a step of it
+                if not along_cut and (abs(gap - depth) < 1e-6 or (at is point and gap > 1e-9)):
                     return start, inward, gap
         return point - depth * inward, inward, float(depth)
     rings = [shapely.LinearRing(loop) for loop in geo.cut_loops]  # straight runs dropped within 0.001 mm:
