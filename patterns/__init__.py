@@ -13,9 +13,12 @@ The public API, all importable from the top level::
 
     blank = patterns.unfold("bracket.step", k_factor=0.44)   # bent sheet metal: one flat blank
     blank.to_dxf("bracket.dxf")                        # outline, holes, bend lines
+
+    result = patterns.batch("parts/", "out/", jobs=2)  # a folder of parts: a row each
 """
 
 from .audit import CheckOptions, Code, DartReport, Finding, PanelReport, Report, SeamReport, Severity, check
+from .batching import BatchOptions, BatchResult, Row, batch
 from .blank import Bend, Blank, BlankCode, BlankFinding
 from .comparison import BlankComparison, compare_blank, read_flat_pattern
 from .cut import Cut, cut_to_disk
@@ -50,6 +53,8 @@ __all__ = [
     "ENERGIES",
     "METHODS",
     "Bend",
+    "BatchOptions",
+    "BatchResult",
     "BendTable",
     "Blank",
     "BlankCode",
@@ -86,6 +91,7 @@ __all__ = [
     "Pattern",
     "PatternsError",
     "Report",
+    "Row",
     "Seam",
     "SeamLengths",
     "SeamReport",
@@ -96,6 +102,7 @@ __all__ = [
     "UnfoldOptions",
     "Unit",
     "__version__",
+    "batch",
     "check",
     "compare_blank",
     "cut_to_disk",

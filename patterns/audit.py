@@ -52,6 +52,8 @@ class Code(str, Enum):
     STRAIN_ABOVE_LIMIT = "strain-above-limit"
     SEAM_MISMATCH_ABOVE_LIMIT = "seam-mismatch-above-limit"
     SEAM_LENGTH_NOT_KEPT = "seam-length-not-kept"
+    AREA_NOT_KEPT = "area-not-kept"
+    GROSSLY_DISTORTED = "grossly-distorted"
     NOT_CONVERGED = "not-converged"
     DARTS = "darts"
 
@@ -173,7 +175,7 @@ class SeamReport:
     """``mismatch / length_3d * 100``."""
 
 
-REPORT_SCHEMA = "patterns.report/3"
+REPORT_SCHEMA = "patterns.report/4"
 """The ``schema`` value of :meth:`Report.to_dict` (see docs/report.md)."""
 
 
@@ -191,6 +193,11 @@ class Report:
         Errors first, then limits, then notes.
     max_strain, max_seam_mismatch : float or None
         The limits asked for.
+    area_tolerance, max_distortion : float or None
+        The limits of a usable pattern (:class:`CheckOptions`).
+    loading : patterns.Bookkeeping or None
+        What loading did to the input (vertices welded, pieces split, cuts
+        made, units converted).
     """
 
     pattern: str
@@ -199,6 +206,9 @@ class Report:
     findings: tuple
     max_strain: float | None = None
     max_seam_mismatch: float | None = None
+    area_tolerance: float | None = None
+    max_distortion: float | None = None
+    loading: object = None
 
     @property
     def ok(self) -> bool:
@@ -218,7 +228,9 @@ class Report:
             "pattern": self.pattern,
             "ok": self.ok,
             "units": {"length": "mm", "area": "mm2", "strain": "ratio (0.01 = 1 %)"},
-            "limits": {"max_strain": self.max_strain, "max_seam_mismatch": self.max_seam_mismatch},
+            "limits": {"max_strain": self.max_strain, "max_seam_mismatch": self.max_seam_mismatch,
+                       "area_tolerance": self.area_tolerance, "max_distortion": self.max_distortion},
+            "loading": None if self.loading is None else {**asdict(self.loading), "said": str(self.loading)},
             "panels": [{**asdict(p), "strain_max_at": list(p.strain_max_at),
                         "darts": [{"length_3d": d.length_3d, "legs_flat": list(d.legs_flat), "tip": list(d.tip)}
                                   for d in p.darts]} for p in self.panels],
@@ -252,7 +264,15 @@ class CheckOptions(Options):
                                       low=0, low_open=True, optional=True, metavar="R")
     max_seam_mismatch: float | None = option(None, "largest acceptable difference of a seam's two flat lengths, "
                                                    "mm (above it the command line exits with 1)",
-                                             low=0, low_open=True, optional=True, metavar="MM")
+                                             low=0, low_open=True, optional=True, unit="mm")
+    area_tolerance: float | None = option(0.05, "a panel whose flat area differs from its 3D area by more than "
+                                                "this ratio is not a usable pattern of it (an error; None: not "
+                                                "checked)", low=0, low_open=True, optional=True, metavar="R")
+    max_distortion: float | None = option(2.0, "a triangle laid flat at more than this factor of its 3D size in "
+                                               "some direction (2: doubled or halved) is grossly distorted; a "
+                                               "panel with more than 1 % of its area so is not a usable pattern "
+                                               "(an error; None: not checked)", low=1, low_open=True,
+                                          optional=True, metavar="F")
 
 
 def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
@@ -299,7 +319,7 @@ def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
     for flat in pattern.panels:
         report, found = _panel_report(flat, max_strain)
         panel_reports.append(report)
-        findings += found
+        findings += found + _usable(flat, report, opts)
     findings += _overlaps_between(pattern)
     seam_reports = []
     for fs in pattern.seams:
@@ -309,7 +329,43 @@ def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
     order = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
     findings.sort(key=lambda f: order[f.severity])
     return Report(pattern.name, tuple(panel_reports), tuple(seam_reports), tuple(findings), max_strain,
-                  max_seam_mismatch)
+                  max_seam_mismatch, opts.area_tolerance, opts.max_distortion, pattern.model.bookkeeping)
+
+
+GROSS_SHARE = 0.01
+"""A panel with more than this share of its 3D area grossly distorted (``max_distortion``) is not usable."""
+
+
+def _usable(flat, report, opts) -> list:
+    """Errors for a panel that is not a usable pattern of its surface, whatever limit was asked for:
+    its flat area off its 3D area (``area_tolerance``), or more than :data:`GROSS_SHARE` of its area
+    laid flat at more than ``max_distortion`` times its size, or a fraction of it, in some direction."""
+    out = []
+    name, none = flat.name, np.zeros(0, dtype=np.int64)
+    change = report.area_flat / report.area_3d - 1.0 if report.area_3d > 0 else 0.0
+    at = np.array([report.strain_max_at])
+    if opts.area_tolerance is not None and abs(change) > opts.area_tolerance:
+        out.append(Finding(Code.AREA_NOT_KEPT, Severity.ERROR, (name,), _readonly(at), none, None,
+                           f"panel {name}: flat area {report.area_flat:.1f} mm^2 is {abs(change):.1%} "
+                           f"{'smaller' if change < 0 else 'larger'} than its 3D area {report.area_3d:.1f} mm^2 "
+                           f"(tolerance {opts.area_tolerance:.1%}): not a usable pattern of this surface; give it "
+                           f"seams or darts"))
+    if opts.max_distortion is not None and flat.flattening.method != "exact":
+        ts = flat.strains
+        with np.errstate(divide="ignore"):
+            factor = np.maximum(ts.stretch[:, 0], np.where(ts.stretch[:, 1] > 0, 1.0 / ts.stretch[:, 1], np.inf))
+        gross = np.flatnonzero(factor > opts.max_distortion)
+        share = float(ts.area_3d[gross].sum() / ts.area_3d.sum()) if len(gross) else 0.0
+        if share > GROSS_SHARE:
+            worst = gross[np.argmax(factor[gross])]
+            c = flat.uv[flat.faces[worst]].mean(axis=0)
+            out.append(Finding(Code.GROSSLY_DISTORTED, Severity.ERROR, (name,), _readonly(c[None, :]),
+                               _readonly(gross), None,
+                               f"panel {name}: {share:.1%} of its area is laid flat at more than "
+                               f"{opts.max_distortion:g} times its size, or 1/{opts.max_distortion:g} of it, in some "
+                               f"direction (worst at ({c[0]:.1f}, {c[1]:.1f}) mm): not a usable pattern of this "
+                               f"surface; give it seams or darts"))
+    return out
 
 
 SEAM_LENGTH_TOLERANCE = 1e-3

@@ -8,32 +8,38 @@ Subcommands::
     patterns check INPUT [--max-strain R] [--max-seam-mismatch MM] [--report OUT.json]
     patterns info INPUT
     patterns demo [-o DIR]
-    patterns batch DIR -o OUTDIR [--jobs N] [--scheduler ADDRESS]
+    patterns batch DIR -o OUTDIR [--jobs N] [--scheduler ADDRESS] [--timeout S] [--report] [--preview]
     patterns unfold PART.STEP -o BLANK.dxf [--k-factor K] [--bend-table CSV] [--fixed-face N]
                     [--report OUT.json] [--compare THEIRS.dxf]
 
-Exit codes: 0 done, 1 the pattern fails a check the user asked for
-(``--max-strain``, ``--max-seam-mismatch``) or has an overlap, 2 bad input or
-usage (one line on stderr; ``--debug`` shows the traceback).  Heavy imports
-happen inside the commands.
+Every run plans, then works, then commits: every option, the input and every
+output are checked before any work (one line, exit 2, nothing written); the
+outputs are written as temporary files and renamed together at the end, so a
+run that fails or is stopped (Ctrl-C, SIGTERM) leaves nothing behind.
+
+Exit codes: 0 done, 1 the pattern is not usable or fails a check the user
+asked for (``--max-strain``, ``--max-seam-mismatch``), 2 bad input or usage
+(one line on stderr; ``--debug``, anywhere on the line, shows the traceback),
+130 interrupted, 143 terminated.  Heavy imports happen inside the commands.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import re
+import signal
 import sys
 import time
 from pathlib import Path
 
-from .errors import InputError, PatternsError
+from .errors import InputError, PatternsError, Terminated
 
 __all__ = ["main"]
 
 EXIT_OK, EXIT_CHECK, EXIT_INPUT = 0, 1, 2
 """Exit codes."""
-
-OUTPUT_SUFFIXES = (".dxf", ".obj")
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
 
 
 class Progress:
@@ -41,7 +47,7 @@ class Progress:
 
     def __init__(self, label: str, *, stream=None, enabled: bool | None = None):
         self.stream = stream or sys.stderr
-        self.enabled = self.stream.isatty() if enabled is None else enabled
+        self.enabled = _isatty(self.stream) if enabled is None else enabled
         self.label = label
         self._last = -1.0
 
@@ -65,24 +71,38 @@ class Progress:
             self.stream.flush()
 
 
+def _isatty(stream) -> bool:
+    try:
+        return stream.isatty()
+    except (AttributeError, ValueError, OSError):
+        return False
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, with its errors as one line (the valid choices included) and exit code 2."""
+
+    def error(self, message: str):
+        raise InputError(f"{message} ({self.prog} --help lists the options)")
+
+
 def _parser() -> argparse.ArgumentParser:
     from . import __version__
     from .audit import CheckOptions
+    from .batching import BatchOptions
     from .export.dxf import DxfOptions
     from .flattening import FlattenOptions
     from .flattening.sheetmetal import UnfoldOptions
     from .options import add_arguments
     from .reading import LoadOptions
 
-    parser = argparse.ArgumentParser(
-        prog="patterns", description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns."
-    )
+    parser = _Parser(prog="patterns",
+                     description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns.")
     parser.add_argument("--version", action="version", version=f"patterns {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of errors (anywhere on the line)")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
 
     # Every option flag below is made from the records the API validates with
-    # (patterns.options): a new option there is a new flag here.
+    # (patterns.options): a new option there is a new flag here, in flatten and batch alike.
     def loading(p, *, positional=True):
         if positional:
             p.add_argument("input", type=Path,
@@ -115,6 +135,7 @@ def _parser() -> argparse.ArgumentParser:
     output(flat)
 
     chk = sub.add_parser("check", help="flatten a part and report strain, seams and overlaps (no pattern file)")
+    chk.add_argument("--heat-map", type=Path, default=None, help="strain heat map (.png or .svg)")
     loading(chk)
     flattening(chk)
     checking(chk)
@@ -136,9 +157,7 @@ def _parser() -> argparse.ArgumentParser:
     batch = sub.add_parser("batch", help="flatten every CAD and mesh file in a folder, in parallel")
     batch.add_argument("folder", type=Path, help="folder of input files (not searched recursively)")
     batch.add_argument("-o", "--output", type=Path, required=True, help="folder for the patterns and reports")
-    batch.add_argument("--jobs", type=int, default=None, help="parallel processes (default: the CPU count)")
-    batch.add_argument("--scheduler", default=None,
-                       help="run on a Dask distributed cluster at this address (needs patterns[dask])")
+    add_arguments(batch.add_argument_group("running"), BatchOptions)
     loading(batch, positional=False)
     flattening(batch)
     checking(batch, report=False)
@@ -160,40 +179,19 @@ def _records(args, name=None):
         records["check"] = from_arguments(CheckOptions, args, name=name)
     if hasattr(args, "profile"):
         records["dxf"] = from_arguments(DxfOptions, args, name=name)
+    if getattr(args, "roll_width", None) is not None:
+        from .options import check_number
+
+        args.roll_width = check_number(args.roll_width, "--roll-width (mm)", low=0, low_open=True, high=1e7)
     return records
 
 
 # --------------------------------------------------------------------------- #
-# The pipeline, shared by the commands
+# What the commands print
 # --------------------------------------------------------------------------- #
 
 
-def _load(path, records):
-    from .reading import load
-
-    model = load(path, records["load"])
-    if model.bookkeeping.welded or model.bookkeeping.unused or model.bookkeeping.cuts:
-        print(f"{path}: {model.bookkeeping}")
-    return model
-
-
-def _flatten(model, records):
-    from .flattening import flatten
-
-    progress = Progress(f"flattening {len(model.panels)} panels")
-    try:
-        return flatten(model, records["flatten"], progress=progress)
-    finally:
-        progress.close()
-
-
-def _check(pattern, records):
-    from .audit import check
-
-    return check(pattern, records["check"])
-
-
-def _print_panels(report, units_note=""):
+def _print_panels(report):
     rows = [("panel", "triangles", "area 3D mm2", "area flat mm2", "strain RMS %", "max %", "p95 %", "one-to-one")]
     for p in report.panels:
         rows.append((p.name, str(p.n_triangles), f"{p.area_3d:.1f}", f"{p.area_flat:.1f}",
@@ -222,81 +220,94 @@ def _verdict(report) -> int:
     return EXIT_OK if report.ok else EXIT_CHECK
 
 
+def _loaded(model, seconds):
+    if model.bookkeeping != type(model.bookkeeping)():
+        print(f"{model.name}: {model.bookkeeping}")
+    print(f"{model.name}: {len(model.panels)} panels, {len(model.seams)} seams "
+          f"(target edge {model.max_edge:.3g} mm), loaded in {seconds:.2f} s")
+
+
+def _wrote(result, records):
+    for kind, path in result.outputs.items():
+        if kind == "pattern" and path.suffix.lower() == ".dxf":
+            dxf = records["dxf"]
+            print(f"wrote {path} ({dxf.profile} profile, {dxf.units})")
+            if dxf.units in ("cm", "m"):
+                print(f"note: {path} is in {dxf.units}: Inkscape's DXF import and dxf2gcode read only mm and inches, "
+                      f"and take it for mm; write mm or in for them")
+        elif kind == "pattern":
+            print(f"wrote {path} (flat mesh, z = 0, in {records['dxf'].units})")
+        elif kind == "preview" and result.part.preview_dpi is not None and path.suffix.lower() == ".png":
+            dpi = result.part.preview_dpi
+            print(f"wrote {path} (the DXF at 1:1 at {dpi:.3g} dpi"
+                  f"{'' if dpi >= 95.9 else ': lowered to stay under 40 megapixels; it prints at 1:1 at that dpi'})")
+        elif kind == "preview":
+            print(f"wrote {path} (the DXF at 1:1)")
+        else:
+            print(f"wrote {path}")
+
+
+class _Run:
+    """A planned run's outputs and what the work gave, for the printing."""
+
+    def __init__(self, outputs, part):
+        self.outputs, self.part = outputs, part
+
+
 # --------------------------------------------------------------------------- #
-# Commands
+# Commands: plan (every check, nothing written), work, commit (all or nothing)
 # --------------------------------------------------------------------------- #
+
+
+def _run_part(args, outputs: dict, records: dict):
+    """Plan the outputs, then flatten the part and write them all, or none."""
+    from .files import Outputs
+    from .jobs import flatten_part, plan_outputs
+    from .reading import check_source
+
+    check_source(args.input)
+    planned = plan_outputs(outputs, inputs=[args.input])
+    progress = Progress("flattening")
+    with Outputs(inputs=[args.input]) as out:
+        try:
+            part = flatten_part(args.input, records, outputs=planned, stage=out.stage,
+                                roll_width=getattr(args, "roll_width", None), progress=progress, loaded=_loaded)
+        finally:
+            progress.close()
+        out.commit()
+    return _Run(planned, part)
 
 
 def _cmd_flatten(args) -> int:
-    suffix = args.output.suffix.lower()
-    if suffix not in OUTPUT_SUFFIXES:
-        raise InputError(f"{args.output}: unknown output type {suffix or '(none)'!r}; use .dxf or .obj")
-    for label, value in (("--preview", args.preview), ("--heat-map", args.heat_map)):
-        if value is not None and value.suffix.lower() not in (".png", ".svg"):
-            raise InputError(f"{value}: {label} writes .png or .svg")
-    records = _records(args, name=str(args.input))  # every option checked before any long work
-    start = time.perf_counter()
-    model = _load(args.input, records)
-    loaded = time.perf_counter() - start
-    if suffix == ".obj" and len(model.panels) != 1:
-        raise InputError(f"{args.input}: {len(model.panels)} panels; a flat .obj holds one, write a .dxf")
-    print(f"{args.input}: {len(model.panels)} panels, {len(model.seams)} seams "
-          f"(target edge {model.max_edge:.3g} mm), loaded in {loaded:.2f} s")
-    start = time.perf_counter()
-    pattern = _flatten(model, records)
-    print(f"flattened ({records['flatten'].method}) in {time.perf_counter() - start:.2f} s")
-    if args.roll_width is not None:
-        nest = pattern.layout(width=args.roll_width, margin=_margin(records["dxf"]))
-        pattern = nest.pattern
-        print(f"nested on a {args.roll_width:g} mm roll: {nest.length:.1f} mm used, efficiency {nest.efficiency:.1%}")
-    report = _check(pattern, records)
-    _print_panels(report)
-    if suffix == ".dxf":
-        pattern.to_dxf(args.output, records["dxf"])
-        print(f"wrote {args.output} ({records['dxf'].profile} profile, {records['dxf'].units})")
-    else:
-        from .export import write_flat_obj
-
-        flat = pattern.panels[0]
-        write_flat_obj(args.output, flat.uv, flat.faces)
-        print(f"wrote {args.output} (flat mesh, z = 0)")
-    if args.report is not None:
-        report.to_json(args.report)
-        print(f"wrote {args.report}")
-    if args.heat_map is not None:
-        pattern.heat_map(args.heat_map)
-        print(f"wrote {args.heat_map}")
-    if args.preview is not None:
-        if suffix != ".dxf":
-            raise InputError(f"{args.preview}: --preview renders the DXF file; write a .dxf")
-        from .export.preview import preview_dxf
-
-        preview_dxf(args.output, args.preview)
-        print(f"wrote {args.preview} (the DXF at 1:1)")
-    return _verdict(report)
-
-
-def _margin(dxf) -> float:
-    """The largest seam allowance of the DXF options (the nesting margin), mm."""
-    allowance = dxf.seam_allowance
-    return max(allowance.values(), default=0.0) if isinstance(allowance, dict) else allowance
+    records = _records(args, name=os.fsdecode(args.input))  # every option checked before any work
+    run = _run_part(args, {"pattern": args.output, "report": args.report, "heat_map": args.heat_map,
+                           "preview": args.preview}, records)
+    part = run.part
+    print(f"flattened ({records['flatten'].method}) in {part.seconds['flatten']:.2f} s")
+    if part.nest is not None:
+        print(f"nested on a {args.roll_width:g} mm roll: {part.nest.length:.1f} mm used, "
+              f"efficiency {part.nest.efficiency:.1%}")
+    _print_panels(part.report)
+    _wrote(run, records)
+    return _verdict(part.report)
 
 
 def _cmd_check(args) -> int:
-    records = _records(args, name=str(args.input))
-    model = _load(args.input, records)
-    pattern = _flatten(model, records)
-    report = _check(pattern, records)
-    _print_panels(report)
-    if args.report is not None:
-        report.to_json(args.report)
-        print(f"wrote {args.report}")
-    return _verdict(report)
+    records = _records(args, name=os.fsdecode(args.input))
+    run = _run_part(args, {"report": args.report, "heat_map": args.heat_map}, records)
+    _print_panels(run.part.report)
+    _wrote(run, records)
+    return _verdict(run.part.report)
 
 
 def _cmd_info(args) -> int:
-    model = _load(args.input, _records(args, name=str(args.input)))
-    print(f"{args.input}: {len(model.panels)} panels, {len(model.seams)} seams, target edge {model.max_edge:.3g} mm")
+    from .reading import check_source, load
+
+    records = _records(args, name=os.fsdecode(args.input))
+    check_source(args.input)
+    start = time.perf_counter()
+    model = load(args.input, records["load"])
+    _loaded(model, time.perf_counter() - start)
     rows = [("panel", "CAD faces", "vertices", "triangles", "outline loops", "area mm2")]
     for p in model.panels:
         rows.append((p.name, ",".join(map(str, p.cad_faces)) or "-", str(len(p.vertices)), str(len(p.faces)),
@@ -308,166 +319,167 @@ def _cmd_info(args) -> int:
             rows.append((str(s.id), f"{model.panels[s.panels[0]].name}/{model.panels[s.panels[1]].name}",
                          "-" if s.cad_edge is None else str(s.cad_edge), f"{s.length:.3f}", str(len(s.points))))
         _table(rows)
+    print(f"loading: {model.bookkeeping}")
     return EXIT_OK
 
 
+DEMO_FILES = (("cup.step", "the part: a hemisphere cup in four panels, built with build123d"),
+              ("cup.dxf", "cutting pattern, machine profile, 10 mm seam allowance"),
+              ("cup_astm.dxf", "the same for garment CAD (ASTM D6673)"),
+              ("cup.json", "report: strain per panel, seam lengths on both sides, findings"),
+              ("cup_heatmap.png", "strain heat map"),
+              ("cup_preview.png", "the DXF rendered at 1:1 (96 dpi)"))
+
+
 def _cmd_demo(args) -> int:
+    from dataclasses import replace
+
     from build123d import export_step
 
     from .audit import check
     from .export.preview import preview_dxf
+    from .files import Outputs, output_target
     from .flattening import flatten
     from .reading import load
     from .samples import cup
 
     out = args.output
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{out}: is a file; name a folder for the demo")
+    created = not out.exists()
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InputError(f"{out}: cannot create the demo folder ({exc.strerror})") from None
-    step = out / "cup.step"
-    export_step(cup(), step)
-    model = load(step)
-    pattern = flatten(model)
-    report = check(pattern, max_strain=0.05)
-    written = [(step, "the part: a hemisphere cup in four panels, built with build123d")]
-    pattern.to_dxf(out / "cup.dxf", seam_allowance=10.0)
-    written.append((out / "cup.dxf", "cutting pattern, machine profile, 10 mm seam allowance"))
-    pattern.to_dxf(out / "cup_astm.dxf", profile="astm", seam_allowance=10.0)
-    written.append((out / "cup_astm.dxf", "the same for garment CAD (ASTM D6673)"))
-    report.to_json(out / "cup.json")
-    written.append((out / "cup.json", "report: strain per panel, seam lengths on both sides, findings"))
-    pattern.heat_map(out / "cup_heatmap.png")
-    written.append((out / "cup_heatmap.png", "strain heat map"))
-    preview_dxf(out / "cup.dxf", out / "cup_preview.png")
-    written.append((out / "cup_preview.png", "the DXF rendered at 1:1 (96 dpi)"))
+    try:
+        for name, what in DEMO_FILES:
+            output_target(out / name, what=what.split(":")[0], error=InputError)
+        with Outputs() as files:
+            step = files.stage(out / "cup.step", what="STEP file")
+            export_step(cup(), step)
+            model = replace(load(step), name="cup.step")  # read from its temporary name
+            pattern = flatten(model)
+            report = check(pattern, max_strain=0.05)
+            dxf = files.stage(out / "cup.dxf", what="DXF file")
+            pattern.to_dxf(dxf, seam_allowance=10.0)
+            pattern.to_dxf(files.stage(out / "cup_astm.dxf", what="DXF file"), profile="astm", seam_allowance=10.0)
+            report.to_json(files.stage(out / "cup.json", what="report"))
+            pattern.heat_map(files.stage(out / "cup_heatmap.png", what="heat map"))
+            preview_dxf(dxf, files.stage(out / "cup_preview.png", what="preview"))
+            files.commit()
+    except BaseException:
+        if created:
+            try:
+                out.rmdir()  # a folder the failed run made, and left empty
+            except OSError:
+                pass
+        raise
     _print_panels(report)
     _verdict(report)  # shows what a strain limit of 5 % finds on a sphere cut in quarters
     print(f"patterns demo: {len(model.panels)} panels, {len(model.seams)} seams; wrote:")
-    for path, what in written:
-        print(f"  {path}  {what}")
+    for name, what in DEMO_FILES:
+        print(f"  {out / name}  {what}")
     return EXIT_OK
 
 
-def _batch_one(path: str, out: str, records: dict, roll_width) -> dict:
-    """Flatten one file into ``out``: a row of the batch summary.  Never raises."""
-    from .audit import check
-    from .flattening import flatten
-    from .reading import load
-
-    start = time.perf_counter()
-    row = {"file": Path(path).name, "panels": None, "seams": None, "strain_rms": None, "strain_max": None,
-           "status": "", "ok": False, "error": None, "seconds": None}
-    try:
-        model = load(path, records["load"])
-        pattern = flatten(model, records["flatten"])
-        if roll_width is not None:
-            pattern = pattern.layout(width=roll_width, margin=_margin(records["dxf"])).pattern
-        report = check(pattern, records["check"])
-        stem = Path(out) / Path(path).stem
-        pattern.to_dxf(stem.with_suffix(".dxf"), records["dxf"])
-        report.to_json(stem.with_suffix(".json"))
-        row.update(panels=len(model.panels), seams=len(model.seams),
-                   strain_rms=max(p.strain_rms for p in report.panels),
-                   strain_max=max(p.strain_max for p in report.panels), ok=report.ok,
-                   status="ok" if report.ok else f"check failed: {report.findings[0].message}")
-    except PatternsError as exc:
-        row.update(status=f"error: {exc}", error=str(exc))
-    except Exception as exc:  # noqa: BLE001 - one bad file must not stop the batch
-        row.update(status=f"error: {type(exc).__name__}: {exc}", error=f"{type(exc).__name__}: {exc}")
-    row["seconds"] = time.perf_counter() - start
-    return row
-
-
 def _cmd_batch(args) -> int:
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    from .reading import CAD_SUFFIXES, MESH_SUFFIXES
+    from .batching import BatchOptions, batch, plan_batch
+    from .options import from_arguments
 
     records = _records(args)  # every option checked before any file is read
-    if not args.folder.is_dir():
-        raise InputError(f"{args.folder}: no such folder")
-    if args.jobs is not None and args.jobs < 1:
-        raise InputError(f"--jobs must be at least 1, got {args.jobs}")
-    files = sorted(p for p in args.folder.iterdir() if p.is_file() and p.suffix.lower() in CAD_SUFFIXES + MESH_SUFFIXES)
-    if not files:
-        raise InputError(f"{args.folder}: no CAD or mesh files in this folder")
-    try:
-        args.output.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"{args.output}: cannot create the output folder ({exc.strerror})") from None
-    progress = Progress(f"batch of {len(files)} files")
-    rows = []
-    if args.scheduler:
-        try:
-            from distributed import Client
-            from distributed import as_completed as dask_completed
-        except ImportError:
-            raise InputError("--scheduler needs Dask: pip install 'patterns[dask]'") from None
-        try:
-            client = Client(args.scheduler, timeout="20s")
-        except (OSError, TimeoutError) as exc:
-            raise InputError(f"{args.scheduler}: cannot reach the Dask scheduler ({exc})") from None
-        with client:
-            futures = [client.submit(_batch_one, str(p), str(args.output), records, args.roll_width, pure=False) for p in files]
-            for future in dask_completed(futures):
-                rows.append(future.result())
-                progress(len(rows), len(files))
-        where = f"Dask scheduler {args.scheduler}"
-    else:
-        jobs = args.jobs or os.cpu_count() or 1
-        with ProcessPoolExecutor(max_workers=min(jobs, len(files))) as pool:
-            futures = [pool.submit(_batch_one, str(p), str(args.output), records, args.roll_width) for p in files]
-            for future in as_completed(futures):
-                rows.append(future.result())
-                progress(len(rows), len(files))
-        where = f"{min(jobs, len(files))} processes"
+    options = from_arguments(BatchOptions, args)
+    files, _ = plan_batch(args.folder, args.output)
+    progress = _BatchProgress(len(files), quiet=options.quiet)
+    result = batch(files, args.output, records=records, options=options, roll_width=args.roll_width,
+                   on_row=progress.row, on_start=progress.start)
     progress.close()
-    rows.sort(key=lambda r: r["file"])
     table = [("file", "panels", "seams", "strain RMS %", "max %", "seconds", "status")]
-    for r in rows:
-        table.append((r["file"], "-" if r["panels"] is None else str(r["panels"]),
-                      "-" if r["seams"] is None else str(r["seams"]),
-                      "-" if r["strain_rms"] is None else f"{100 * r['strain_rms']:.2f}",
-                      "-" if r["strain_max"] is None else f"{100 * r['strain_max']:.2f}",
-                      f"{r['seconds']:.1f}", r["status"]))
+    for r in result.rows:
+        status = r.status + (f": {r.reason}" if r.reason else "")
+        table.append((r.file, "-" if r.panels is None else str(r.panels), "-" if r.seams is None else str(r.seams),
+                      "-" if r.strain_rms is None else f"{100 * r.strain_rms:.2f}",
+                      "-" if r.strain_max is None else f"{100 * r.strain_max:.2f}", f"{r.seconds:.1f}", status))
     _table(table)
-    errors = [r for r in rows if r["error"]]
-    failed = [r for r in rows if not r["error"] and not r["ok"]]
-    print(f"batch: {len(rows) - len(errors)} results, {len(errors)} failed, {len(failed)} failing a check "
-          f"({where}); wrote {args.output}")
-    if errors:
-        return EXIT_INPUT
-    return EXIT_CHECK if failed else EXIT_OK
+    counts = ", ".join(f"{result.count(s)} {s}" for s in ("ok", "check failed", "failed", "timeout", "lost", "not run")
+                       if result.count(s))
+    written = sum(bool(r.written) for r in result.rows)
+    stop = f"{result.stopped}: " if result.stopped else ""
+    print(f"batch: {stop}{len(result.rows)} files: {counts} ({result.where}); "
+          f"{written} written to {os.fsdecode(args.output)}", file=sys.stderr if result.stopped else sys.stdout)
+    return result.exit_code
+
+
+class _BatchProgress:
+    """A batch's progress: a bar with the file names, failures and time left on a terminal; else a line
+    per finished file (for logs, CI, nohup); nothing with --quiet."""
+
+    def __init__(self, total: int, *, quiet: bool = False, stream=None):
+        self.total, self.quiet = total, quiet
+        self.stream = stream or sys.stderr
+        self.bar = _isatty(self.stream) and not quiet
+        self.start_time, self.done, self.bad, self.running = time.monotonic(), 0, 0, []
+
+    def start(self, name: str) -> None:
+        self.running.append(name)
+        self._draw()
+
+    def row(self, row, done: int, total: int) -> None:
+        self.done = done
+        self.bad += row.status not in ("ok", "check failed")
+        if row.file in self.running:
+            self.running.remove(row.file)
+        if self.quiet:
+            return
+        if not self.bar:
+            reason = f": {row.reason}" if row.reason else ""
+            print(f"[{done}/{total}] {row.file}: {row.status}{reason} ({row.seconds:.1f} s)", file=self.stream,
+                  flush=True)
+        self._draw()
+
+    def _draw(self) -> None:
+        if not self.bar:
+            return
+        elapsed = time.monotonic() - self.start_time
+        left = f", about {elapsed / self.done * (self.total - self.done):.0f} s left" if self.done else ""
+        names = ", ".join(self.running[:2]) + (" ..." if len(self.running) > 2 else "")
+        text = f"batch {self.done}/{self.total}, {self.bad} failed{left}  {names}"
+        self.stream.write("\r" + text[:100].ljust(100))
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.bar:
+            self.stream.write("\n")
+            self.stream.flush()
 
 
 def _cmd_unfold(args) -> int:
     from .comparison import compare_blank, read_flat_pattern
+    from .files import Outputs, check_input_file, output_target
     from .flattening.sheetmetal import UnfoldOptions, unfold
     from .options import from_arguments
+    from .reading import CAD_SUFFIXES, check_source
 
+    options = from_arguments(UnfoldOptions, args, name=os.fsdecode(args.input))  # the bend table read and checked
+    check_source(args.input, CAD_SUFFIXES)
     if args.output.suffix.lower() != ".dxf":
         raise InputError(f"{args.output}: unfold writes a .dxf blank")
     if args.report is not None and args.report.suffix.lower() != ".json":
         raise InputError(f"{args.report}: --report writes .json")
-    written = [args.output] + ([args.report] if args.report is not None else [])
-    for out in written:
-        if out.resolve() == args.input.resolve() or (args.compare and out.resolve() == args.compare.resolve()):
-            raise InputError(f"{out}: is an input of this run; name another output")
-    if args.report is not None and args.report.resolve() == args.output.resolve():
+    inputs = [args.input] + ([args.compare] if args.compare is not None else [])
+    if args.compare is not None:
+        check_input_file(args.compare, what="DXF file")
+    outputs = [(args.output, "DXF file")] + ([(args.report, "report")] if args.report is not None else [])
+    for path, what in outputs:
+        output_target(path, what=what, inputs=inputs, error=InputError)
+    if args.report is not None and output_target(args.report, error=InputError) == output_target(args.output,
+                                                                                                  error=InputError):
         raise InputError(f"{args.report}: the report and the blank cannot be the same file")
-    for out in written:
-        if out.exists() and out.is_dir():
-            raise InputError(f"{out}: is a folder; name a file")
-        if not (out.parent if str(out.parent) else Path(".")).is_dir():
-            raise InputError(f"{out}: folder {out.parent} does not exist")
-    options = from_arguments(UnfoldOptions, args, name=str(args.input))  # the bend table read and checked here
     reference = read_flat_pattern(args.compare) if args.compare is not None else None
     start = time.perf_counter()
     blank = unfold(args.input, options)
     seconds = time.perf_counter() - start
     w, h = blank.size
-    print(f"{args.input}: sheet {blank.thickness:g} mm, {len(blank.bends)} bends, {len(blank.holes)} holes; "
+    print(f"{blank.name}: sheet {blank.thickness:g} mm, {len(blank.bends)} bends, {len(blank.holes)} holes; "
           f"blank {w:.2f} x {h:.2f} mm, area {blank.area:.1f} mm2, usage {blank.usage:.1%} (unfolded in "
           f"{seconds:.2f} s)")
     rows = [("bend", "direction", "angle deg", "inside R mm", "allowance mm")]
@@ -483,7 +495,7 @@ def _cmd_unfold(args) -> int:
         print(f"against {args.compare}: area {c.area_error:+.4%}, outer perimeter {c.perimeter - c.perimeter_reference:+.3f}"
               f" mm, holes {c.holes}/{c.holes_reference}, bend lines {c.bend_lines}/{c.bend_lines_reference}, outline "
               f"Hausdorff {c.hausdorff:.3f} mm ({c.within:.1%} of it within 0.1 mm)")
-        extra["comparison"] = {"reference": str(args.compare), "area_error": c.area_error,
+        extra["comparison"] = {"reference": os.fsdecode(args.compare), "area_error": c.area_error,
                                "perimeter_mm": c.perimeter, "perimeter_reference_mm": c.perimeter_reference,
                                "holes_reference": c.holes_reference, "bend_lines_reference": c.bend_lines_reference,
                                "hausdorff_mm": c.hausdorff, "hausdorff_all_mm": c.hausdorff_all,
@@ -491,14 +503,13 @@ def _cmd_unfold(args) -> int:
     if not blank.ok:
         print(f"{args.output}: not written (the blank cannot be cut as it is)")
         return EXIT_CHECK
-    blank.to_dxf(args.output)
+    with Outputs(inputs=inputs) as files:
+        blank.to_dxf(files.stage(args.output, what="DXF file"))
+        if args.report is not None:
+            blank.to_json(files.stage(args.report, what="report"), extra=extra)
+        files.commit()
     print(f"wrote {args.output}")
     if args.report is not None:
-        try:
-            blank.to_json(args.report, extra=extra)
-        except BaseException:
-            args.output.unlink(missing_ok=True)  # a failed run leaves nothing
-            raise
         print(f"wrote {args.report}")
     return EXIT_OK
 
@@ -507,13 +518,28 @@ COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "de
             "batch": _cmd_batch}
 
 
-class _ClosedPipeSafe:
-    """Standard output that outlives its reader.
+# --------------------------------------------------------------------------- #
+# The terminal: names are data, a closed pipe is not an error, signals end cleanly
+# --------------------------------------------------------------------------- #
 
-    ``patterns flatten part.step | head -1`` closes the pipe after one line; the
-    files must still be written and no traceback shown, so output to a closed
-    pipe is dropped (and the descriptor pointed at ``/dev/null``, so that the
-    interpreter's last flush is quiet too).
+_CONTROL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ud800-\udfff]")
+
+
+def _visible(match: re.Match) -> str:
+    code = ord(match.group(0))
+    return f"\\x{code - 0xDC00:02x}" if 0xDC80 <= code <= 0xDCFF else f"\\x{code:02x}" if code < 0x100 \
+        else f"\\u{code:04x}"
+
+
+class _Terminal:
+    """Standard output or error as the command line writes it.
+
+    Every control character but newline, tab and carriage return, and every
+    byte of a file name that is not UTF-8, is written as a visible escape
+    (``\\x1b``): a file named with an escape sequence cannot drive the terminal,
+    and an undecodable name cannot stop the run.  Output to a closed pipe
+    (``patterns flatten part.step | head -1``) is dropped: the files are still
+    written and no traceback is shown.
     """
 
     def __init__(self, stream):
@@ -522,7 +548,7 @@ class _ClosedPipeSafe:
     def write(self, text: str) -> int:
         if not self._gone:
             try:
-                return self._stream.write(text)
+                return self._stream.write(_CONTROL.sub(_visible, text))
             except BrokenPipeError:
                 self._close()
         return len(text)
@@ -545,11 +571,22 @@ class _ClosedPipeSafe:
         return getattr(self._stream, name)
 
 
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
 def main(argv=None) -> int:
     """Run the command line; returns the exit code."""
-    argv = sys.argv[1:] if argv is None else argv
+    argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
-    stdout, sys.stdout = sys.stdout, _ClosedPipeSafe(sys.stdout)
+    argv = [a for a in argv if a != "--debug"]  # anywhere on the line
+    saved = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = _Terminal(sys.stdout), _Terminal(sys.stderr)
+    previous = None
+    try:
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    except ValueError:  # not the main thread (a test harness): no handler
+        pass
     try:
         args = _parser().parse_args(argv)
         return COMMANDS[args.command](args)
@@ -558,11 +595,24 @@ def main(argv=None) -> int:
             raise
         print(f"patterns: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
-    except KeyboardInterrupt:  # pragma: no cover
-        return 130
+    except MemoryError:
+        if debug:
+            raise
+        print("patterns: error: out of memory (the part, or an option, asks for more than this machine has); "
+              "nothing written", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("patterns: interrupted; nothing written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Terminated:
+        print("patterns: terminated; nothing written", file=sys.stderr)
+        return EXIT_TERMINATED
     finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
         sys.stdout.flush()
-        sys.stdout = stdout
+        sys.stderr.flush()
+        sys.stdout, sys.stderr = saved
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -27,6 +27,7 @@ from .mesh import (
     _readonly,
     as_mesh_arrays,
     check_boundary_vertices,
+    check_faces_have_area,
     corner_angles,
     edge_graph,
     edge_tables,
@@ -34,7 +35,8 @@ from .mesh import (
     unique_edges,
 )
 
-__all__ = ["Cut", "Inserted", "cut_along", "cut_to_disk", "insert_line", "pieces"]
+__all__ = ["Cut", "Inserted", "crease_pieces", "cut_along", "cut_to_disk", "insert_line", "is_closed", "pieces",
+           "shared_chains"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,6 +94,118 @@ def pieces(faces: np.ndarray, n_vertices: int, *, name: str = "mesh") -> list[np
     return groups
 
 
+def is_closed(faces: np.ndarray, n_vertices: int, *, name: str = "mesh") -> bool:
+    """True when a manifold piece has no boundary at all (a sphere, a box: it encloses a volume)."""
+    return bool((edge_tables(faces, n_vertices, name=name).edge_faces[:, 1] >= 0).all())
+
+
+def crease_pieces(vertices: np.ndarray, faces: np.ndarray, *, angle: float, name: str = "mesh") -> list[np.ndarray]:
+    """Split a piece into the regions its creases bound: edges whose two faces meet at more than ``angle``.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+        One manifold, consistently wound piece.
+    angle : float
+        Degrees between the two faces' normals (0: coplanar; a box's edges: 90).
+    name : str
+        For error messages.
+
+    Returns
+    -------
+    list of (m_i,) int64
+        Face indices of each region, in order of their first face; one region
+        (all faces) when no closed line of creases separates any.
+    """
+    t = edge_tables(faces, len(vertices), name=name)
+    p = vertices[faces]
+    normals = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+    inner = t.edge_faces[t.edge_faces[:, 1] >= 0]
+    cosine = np.einsum("ij,ij->i", normals[inner[:, 0]], normals[inner[:, 1]])
+    smooth = inner[cosine >= np.cos(np.radians(angle))]
+    m = len(faces)
+    graph = sp.coo_matrix((np.ones(len(smooth), dtype=np.int8), (smooth[:, 0], smooth[:, 1])), shape=(m, m))
+    n, label = csgraph.connected_components(graph, directed=False)
+    order = np.argsort(label, kind="stable")
+    groups = np.split(order, np.cumsum(np.bincount(label, minlength=n))[:-1])
+    groups.sort(key=lambda g: g[0])
+    return groups
+
+
+def shared_chains(faces: np.ndarray, groups: list) -> list[tuple[int, int, np.ndarray]]:
+    """The lines along which regions of one mesh meet: ``(region a, region b, path)`` with ``a < b``.
+
+    Parameters
+    ----------
+    faces : (m, 3) int64
+    groups : list of (m_i,) int64
+        A partition of the faces into regions (see :func:`crease_pieces`).
+
+    Returns
+    -------
+    list of (int, int, (p,) int64)
+        Each maximal chain of edges between the same two regions, as a path of
+        vertex indices; it ends where three regions meet, or is closed (its
+        first vertex repeated at the end).
+    """
+    region = np.empty(len(faces), dtype=np.int64)
+    for k, g in enumerate(groups):
+        region[g] = k
+    t = edge_tables(faces, int(faces.max()) + 1)
+    inner = t.edge_faces[:, 1] >= 0
+    ra, rb = region[t.edge_faces[:, 0]], np.where(inner, region[np.maximum(t.edge_faces[:, 1], 0)], -1)
+    between = inner & (ra != rb)
+    out = []
+    pairs = np.stack([np.minimum(ra, rb), np.maximum(ra, rb)], axis=1)[between]
+    edges = t.edges[between]
+    for a, b in _unique_pairs(pairs):
+        chosen = edges[(pairs[:, 0] == a) & (pairs[:, 1] == b)]
+        out += [(int(a), int(b), path) for path in _chains(chosen)]
+    return out
+
+
+def _unique_pairs(pairs: np.ndarray) -> np.ndarray:
+    """The distinct rows of an ``(k, 2)`` int array, sorted."""
+    return np.unique(pairs, axis=0) if len(pairs) else pairs.reshape(0, 2)
+
+
+def _chains(edges: np.ndarray) -> list[np.ndarray]:
+    """Edges ``(k, 2)`` joined into maximal paths (split where a vertex has other than two), then cycles."""
+    neighbours: dict = {}
+    for a, b in edges.tolist():
+        neighbours.setdefault(a, []).append(b)
+        neighbours.setdefault(b, []).append(a)
+    used = set()
+    paths = []
+
+    def walk(start, nxt):
+        path = [start]
+        prev, cur = start, nxt
+        used.add(frozenset((start, nxt)))
+        while True:
+            path.append(cur)
+            if len(neighbours[cur]) != 2 or cur == start:
+                return path
+            step = [w for w in neighbours[cur] if frozenset((cur, w)) not in used]
+            if not step:
+                return path
+            prev, cur = cur, step[0]
+            used.add(frozenset((prev, cur)))
+
+    for v in sorted(neighbours):
+        if len(neighbours[v]) != 2:
+            for w in neighbours[v]:
+                if frozenset((v, w)) not in used:
+                    paths.append(np.array(walk(v, w), dtype=np.int64))
+    for v in sorted(neighbours):
+        for w in neighbours[v]:
+            if frozenset((v, w)) not in used:
+                paths.append(np.array(walk(v, w), dtype=np.int64))  # a cycle: back at its start
+    return paths
+
+
 def loop_turning(vertices: np.ndarray, faces: np.ndarray, loop: np.ndarray) -> float:
     """Geodesic turning of a boundary loop: ``sum over its vertices of (pi - corner angles)``.
 
@@ -135,6 +249,7 @@ def cut_to_disk(vertices: np.ndarray, faces: np.ndarray, *, name: str = "mesh") 
         open; or a cut that could not be routed.
     """
     vertices, faces = as_mesh_arrays(vertices, faces, name=name)  # array_like in; checked shapes and values
+    check_faces_have_area(vertices, faces, name=name)
     n, m = len(vertices), len(faces)
     t = edge_tables(faces, n, name=name)
     check_boundary_vertices(t, n, name=name)

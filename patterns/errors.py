@@ -19,6 +19,7 @@ __all__ = [
     "LayoutError",
     "MeshTopologyError",
     "PatternsError",
+    "Terminated",
 ]
 
 
@@ -50,3 +51,8 @@ class ExportError(PatternsError, OSError):
 
 class LayoutError(PatternsError):
     """The panels cannot be laid out as asked (a panel wider than the roll in every allowed orientation)."""
+
+
+class Terminated(BaseException):
+    """The process was asked to stop (SIGTERM), raised where it was: every ``finally`` runs, so
+    temporary files are removed and worker processes stopped.  Not an error of the input."""

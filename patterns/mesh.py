@@ -20,12 +20,15 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from .errors import InputError, MeshTopologyError
+from .units import LARGEST_LENGTH
 
 __all__ = [
+    "MAX_TRIANGLES",
     "Connectivity",
     "EdgeTables",
     "as_mesh_arrays",
     "boundary_loops",
+    "check_faces_have_area",
     "check_boundary_vertices",
     "corner_angles",
     "drop_unused",
@@ -82,6 +85,34 @@ class Connectivity:
         return np.flatnonzero(self.edge_faces[:, 1] < 0)
 
 
+def check_faces_have_area(vertices: np.ndarray, faces: np.ndarray, *, name: str = "mesh") -> None:
+    """InputError naming the first of the degenerate faces: a corner repeated, or (next to) no area.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+        Valid indices (see :func:`as_mesh_arrays`).
+    name : str
+        For the message.
+    """
+    repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0])
+    area = face_areas(vertices, faces)
+    scale = float(np.ptp(vertices, axis=0).max()) if len(vertices) else 0.0
+    degenerate = repeated | (area <= (1e-14 * scale) ** 2 * 0.5) | ~np.isfinite(area)
+    if degenerate.any():
+        raise InputError(
+            f"{name}: {int(degenerate.sum())} degenerate (zero-area) faces "
+            f"(first: face {int(np.flatnonzero(degenerate)[0])})"
+        )
+
+
+MAX_TRIANGLES = 4_000_000
+"""The most triangles a part may have: CAD meshing that would make more is refused before it
+starts (a tiny ``max_edge`` must not hang the machine), and so is a mesh file that holds more
+(about 1.5 GB of memory and a minute or two per million in the engine)."""
+
+
 def as_mesh_arrays(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, np.ndarray]:
     """Convert to ``(float64 (n, 3), int64 (m, 3))`` arrays, checking shape and values.
 
@@ -102,7 +133,9 @@ def as_mesh_arrays(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, 
     Raises
     ------
     InputError
-        On a wrong shape, NaN/inf coordinates, non-integer or out-of-range indices.
+        On a wrong shape, NaN/inf coordinates, coordinates beyond
+        :data:`~patterns.units.LARGEST_LENGTH` (10 km), non-integer or
+        out-of-range indices.
     """
     try:
         v = np.array(vertices, dtype=np.float64)
@@ -125,6 +158,13 @@ def as_mesh_arrays(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, 
         raise InputError(
             f"{name}: {int(bad.sum())} vertices have NaN or infinite coordinates "
             f"(first: vertex {int(np.flatnonzero(bad)[0])})"
+        )
+    far = (np.abs(v) > LARGEST_LENGTH).any(axis=1)
+    if far.any():
+        first = int(np.flatnonzero(far)[0])
+        raise InputError(
+            f"{name}: {int(far.sum())} vertices lie beyond {LARGEST_LENGTH:g} mm (10 km) of the origin (first: "
+            f"vertex {first} at {np.abs(v[first]).max():.3g}); parts are read in mm: check the file's unit"
         )
     out = (f < 0) | (f >= len(v))
     if out.any():
@@ -378,16 +418,7 @@ def validate_mesh(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, n
     """
     v, f = as_mesh_arrays(vertices, faces, name=name)
     n, m = len(v), len(f)
-
-    repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
-    area = face_areas(v, f)
-    scale = float(np.ptp(v, axis=0).max()) if n else 0.0
-    degenerate = repeated | (area <= (1e-14 * scale) ** 2 * 0.5) | ~np.isfinite(area)
-    if degenerate.any():
-        raise InputError(
-            f"{name}: {int(degenerate.sum())} degenerate (zero-area) faces "
-            f"(first: face {int(np.flatnonzero(degenerate)[0])})"
-        )
+    check_faces_have_area(v, f, name=name)
     used = np.zeros(n, dtype=bool)
     used[f.ravel()] = True
     if not used.all():

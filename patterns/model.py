@@ -174,19 +174,28 @@ class Bookkeeping:
     unused : int
         Vertices no face used, dropped.
     cuts : int
-        Cuts made to open a closed or tube-like piece into a disk (seams with
-        no CAD edge; each is a seam of the model).
+        Cuts made to open a tube-like piece into a disk (seams with no CAD
+        edge; each is a seam of the model).
+    split : int
+        Closed pieces split into panels along their creases (mesh files).
+    units : str
+        The unit the file's coordinates were read in and converted from to mm
+        (``"mm"``: nothing converted).
     """
 
     welded: int = 0
     unused: int = 0
     cuts: int = 0
+    split: int = 0
+    units: str = "mm"
 
     def __str__(self) -> str:
         parts = [f"{self.welded} vertices welded" if self.welded else "",
                  f"{self.unused} unused vertices dropped" if self.unused else "",
-                 f"{self.cuts} cut{'s' if self.cuts != 1 else ''} made to open tubes or closed pieces"
-                 if self.cuts else ""]
+                 f"{self.cuts} cut{'s' if self.cuts != 1 else ''} made to open tubes" if self.cuts else "",
+                 f"{self.split} closed piece{'s' if self.split != 1 else ''} split into panels along creases"
+                 if self.split else "",
+                 f"coordinates read in {self.units} and converted to mm" if self.units != "mm" else ""]
         return "; ".join(p for p in parts if p) or "nothing welded, dropped or cut"
 
 

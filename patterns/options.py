@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError
+from .units import LARGEST_LENGTH
 
 __all__ = ["Options", "Spec", "add_arguments", "check_number", "cli_flags", "from_arguments", "is_number", "option"]
 
@@ -71,6 +72,8 @@ def _describe(low, high, low_open, high_open, integer) -> str:
     """``"a positive number"``, ``"an integer >= 0"``, ``"a number between 0 and 1"``, ..."""
     kind = "integer" if integer else "number"
     article = "an" if integer else "a"
+    if low == 0 and low_open and high == LARGEST_LENGTH:
+        return f"a positive {kind} {'<' if high_open else '<='} {high:g}"
     if low is not None and high is not None:
         return f"{article} {kind} between {low:g} and {high:g}"
     if low == 0 and low_open:
@@ -113,6 +116,9 @@ class Spec:
     repeat : bool
         The CLI flag may be given several times; the values come as a list.
     metavar : str, optional
+    unit : {"mm"}, optional
+        A length in millimetres: at most :data:`~patterns.units.LARGEST_LENGTH`
+        (whatever ``high`` says), shown as ``MM`` on the command line.
     """
 
     help: str
@@ -128,6 +134,12 @@ class Spec:
     check: Callable | None = None
     repeat: bool = False
     metavar: str | None = None
+    unit: str | None = None
+
+    def __post_init__(self):
+        if self.unit == "mm":
+            object.__setattr__(self, "high", LARGEST_LENGTH if self.high is None else min(self.high, LARGEST_LENGTH))
+            object.__setattr__(self, "metavar", self.metavar or "MM")
 
     def validate(self, value, option: str, default):
         """``value`` checked (numbers as Python numbers), or InputError naming ``option``."""
@@ -282,7 +294,7 @@ def add_arguments(parser, record: type, *, skip: tuple = ()) -> None:
             else:
                 parser.add_argument(flag, dest=_dest(flag), action="store_true", help=text)
             continue
-        kind = spec.parse or (int if spec.integer else float if spec.choices is None and (
+        kind = _typed(spec.parse) if spec.parse else (int if spec.integer else float if spec.choices is None and (
             spec.low is not None or spec.high is not None or is_number(f.default)) else str)
         default = None if spec.repeat else f.default
         default = default.value if isinstance(default, Enum) else default
@@ -290,6 +302,21 @@ def add_arguments(parser, record: type, *, skip: tuple = ()) -> None:
                             action="append" if spec.repeat else "store", metavar=spec.metavar,
                             help=text + ("" if default in (None, "") else f" (default {default})"))
     del argparse
+
+
+def _typed(parse: Callable) -> Callable:
+    """A parse function whose ValueError argparse shows as it is (``expected X,Y,Z ...``), not as
+    ``invalid parse_direction value``."""
+    import argparse
+
+    def typed(text):
+        try:
+            return parse(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    typed.__name__ = parse.__name__
+    return typed
 
 
 def from_arguments(record: type, args, *, name: str | None = None, **extra):

@@ -19,20 +19,28 @@ count is reported.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import re
+import sys
+import tempfile
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
 
-from .cut import cut_to_disk, pieces
-from .errors import CadError, InputError
-from .mesh import as_mesh_arrays, drop_unused, polyline_length, unique_ints
+from .cut import crease_pieces, cut_to_disk, is_closed, pieces, shared_chains
+from .errors import CadError, InputError, MeshTopologyError
+from .files import check_input_file
+from .mesh import MAX_TRIANGLES, as_mesh_arrays, check_faces_have_area, drop_unused, polyline_length, unique_ints
 from .model import Bookkeeping, Model, Seam, panel_from_mesh
 from .options import option
 from .tessellate import MeshingOptions, mesh_shape
+from .text import printable
 from .units import UNIT_NAMES, Unit
 
-__all__ = ["CAD_SUFFIXES", "LoadOptions", "MESH_SUFFIXES", "MeshFile", "drop_unused", "load", "mesh_model", "read_cad", "read_mesh", "weld"]
+__all__ = ["CAD_SUFFIXES", "MAX_FILE_BYTES", "MESH_SUFFIXES", "LoadOptions", "MeshFile", "check_source", "drop_unused",
+           "load", "mesh_model", "read_cad", "read_mesh", "weld"]
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".3mf")
 """File suffixes :func:`read_mesh` reads."""
@@ -109,16 +117,56 @@ def _unique_rows(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return order[starts], inverse  # lexsort is stable: each group's first row is its lowest index
 
 
+MAX_FILE_BYTES = 1 << 30
+"""The largest input file read, bytes (1 GiB: some 4 million triangles as ASCII STL); a 3MF's
+members are counted as they would be inflated, before anything is inflated."""
+
+
 def _existing_file(path, suffixes, kind: str) -> tuple[Path, str]:
-    """``(Path, lower-case suffix)`` of an existing file of a known type, else the one-line InputError."""
+    """``(Path, lower-case suffix)`` of a readable regular file of a known type, else the one-line InputError."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in suffixes:
-        raise InputError(f"{path}: unknown {kind} file type {suffix or '(none)'!r}; "
+        raise InputError(f"{os.fsdecode(path)}: unknown {kind} file type {suffix or '(none)'!r}; "
                          f"expected one of {', '.join(suffixes)}")
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
+    check_input_file(path, what=f"{kind} file")
+    size = path.stat().st_size
+    if size > MAX_FILE_BYTES:
+        raise InputError(f"{os.fsdecode(path)}: {size / 2**30:.1f} GiB, over the limit of "
+                         f"{MAX_FILE_BYTES / 2**30:.0f} GiB for one part")
     return path, suffix
+
+
+def check_source(path, suffixes=None) -> Path:
+    """``path`` as a part file this run can read: a known suffix, a readable regular file, not too large.
+
+    The check :func:`load` makes first, for a caller that plans a run before
+    doing any work (the command line).  Raises the same one-line InputError.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{os.fsdecode(path)}: is a folder; give a CAD or mesh file")
+    suffixes = suffixes or CAD_SUFFIXES + MESH_SUFFIXES
+    if path.suffix.lower() not in suffixes:
+        raise InputError(f"{os.fsdecode(path)}: unknown file type {path.suffix.lower() or '(none)'!r}; expected a "
+                         f"CAD file ({', '.join(CAD_SUFFIXES)}) or a mesh file ({', '.join(MESH_SUFFIXES)})")
+    kind = "CAD" if path.suffix.lower() in CAD_SUFFIXES else "mesh"
+    return _existing_file(path, suffixes, kind)[0]
+
+
+def _check_zip(path: Path, data: bytes) -> None:
+    """A 3MF is a zip: refuse it before inflating when its members would exceed MAX_FILE_BYTES."""
+    import io
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(io.BytesIO(data)) as z:
+            inflated = sum(info.file_size for info in z.infolist())
+    except (zipfile.BadZipFile, OSError, ValueError) as exc:
+        raise InputError(f"{os.fsdecode(path)}: cannot read this .3mf file (not a zip archive: {exc})") from None
+    if inflated > MAX_FILE_BYTES:
+        raise InputError(f"{os.fsdecode(path)}: its members inflate to {inflated / 2**30:.1f} GiB, over the limit "
+                         f"of {MAX_FILE_BYTES / 2**30:.0f} GiB for one part ({len(data) / 2**20:.1f} MiB packed)")
 
 
 def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
@@ -144,18 +192,35 @@ def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
         the message names the file.
     """
     path, suffix = _existing_file(path, MESH_SUFFIXES, "mesh")
+    import io
+
     import trimesh  # heavy; only when a file is read
 
+    shown = os.fsdecode(path)
     try:
-        loaded = trimesh.load(path, file_type=suffix[1:], process=False, force="mesh")
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{shown}: cannot read the mesh file ({exc.strerror})") from None
+    if suffix == ".3mf":
+        _check_zip(path, data)
+    # From memory, with no resolver: an OBJ's material library (mtllib) is never opened -- it
+    # may name anything, a pipe or a device among them -- and materials do not matter here.
+    extra = {"skip_materials": True} if suffix == ".obj" else {}
+    try:
+        loaded = trimesh.load(io.BytesIO(data), file_type=suffix[1:], process=False, force="mesh", **extra)
+    except MemoryError:
+        raise
     except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds on a broken file
-        raise InputError(f"{path}: cannot read this {suffix} file ({exc})") from None
+        raise InputError(f"{shown}: cannot read this {suffix} file ({type(exc).__name__}: {exc})") from None
     if isinstance(loaded, trimesh.Scene):  # pragma: no cover - force="mesh" folds scenes
         geometries = list(loaded.geometry.values())
         loaded = trimesh.util.concatenate(geometries) if geometries else None
     if loaded is None or len(getattr(loaded, "faces", ())) == 0:
-        raise InputError(f"{path}: the file holds no triangles")
-    vertices, faces = as_mesh_arrays(loaded.vertices, loaded.faces, name=str(path))
+        raise InputError(f"{shown}: the file holds no triangles")
+    if len(loaded.faces) > MAX_TRIANGLES:
+        raise InputError(f"{shown}: {len(loaded.faces)} triangles, over the limit of {MAX_TRIANGLES:.0e}; "
+                         f"decimate the mesh or split it into parts")
+    vertices, faces = as_mesh_arrays(loaded.vertices, loaded.faces, name=shown)
     if weld_vertices is None:
         weld_vertices = suffix in (".stl", ".3mf")
     if weld_vertices:
@@ -174,6 +239,7 @@ def read_cad(path):
     Parameters
     ----------
     path : str or Path
+        Any name the file system allows (bytes that are not UTF-8 too).
 
     Returns
     -------
@@ -184,41 +250,96 @@ def read_cad(path):
     Raises
     ------
     InputError
-        Missing file or unknown suffix.
+        Missing, unreadable (permission) or special file, or an unknown suffix.
     CadError
-        The file is empty, corrupt, or holds no shape.
+        The file is empty, corrupt, or holds no shape; the message carries
+        OpenCascade's own first complaint, which is kept off the console.
     """
     path, suffix = _existing_file(path, CAD_SUFFIXES, "CAD")
+    shown = os.fsdecode(path)
     if path.stat().st_size == 0:
-        raise CadError(f"{path}: the file is empty")
+        raise CadError(f"{shown}: the file is empty")
     from OCP.IFSelect import IFSelect_RetDone
 
     kind = {".step": "STEP", ".stp": "STEP", ".iges": "IGES", ".igs": "IGES"}.get(suffix, "BREP")
-    try:
-        if kind == "BREP":
-            from OCP.BRep import BRep_Builder
-            from OCP.BRepTools import BRepTools
-            from OCP.TopoDS import TopoDS_Shape
+    shape = None
+    with _utf8_name(path) as name, _native_stdout() as said:
+        try:
+            if kind == "BREP":
+                from OCP.BRep import BRep_Builder
+                from OCP.BRepTools import BRepTools
+                from OCP.TopoDS import TopoDS_Shape
 
-            shape = TopoDS_Shape()
-            ok = BRepTools.Read_s(shape, str(path), BRep_Builder())
-        else:
-            if kind == "STEP":
-                from OCP.STEPControl import STEPControl_Reader as Reader
+                shape = TopoDS_Shape()
+                ok = BRepTools.Read_s(shape, name, BRep_Builder())
             else:
-                from OCP.IGESControl import IGESControl_Reader as Reader
-            reader = Reader()
-            ok = reader.ReadFile(str(path)) == IFSelect_RetDone
-            if ok:
-                reader.TransferRoots()
-                shape = reader.OneShape()
-    except Exception as exc:  # noqa: BLE001 - OpenCascade raises many kinds
-        raise CadError(f"{path}: cannot read this {kind} file ({type(exc).__name__}: {exc})") from None
+                if kind == "STEP":
+                    from OCP.STEPControl import STEPControl_Reader as Reader
+                else:
+                    from OCP.IGESControl import IGESControl_Reader as Reader
+                reader = Reader()
+                ok = reader.ReadFile(name) == IFSelect_RetDone
+                if ok:
+                    reader.TransferRoots()
+                    shape = reader.OneShape()
+        except Exception as exc:  # noqa: BLE001 - OpenCascade raises many kinds
+            raise CadError(f"{shown}: cannot read this {kind} file ({type(exc).__name__}: {exc})") from None
     if not ok:
-        raise CadError(f"{path}: not a readable {kind} file (corrupt, truncated or another format)")
+        why = _first_complaint(said)
+        raise CadError(f"{shown}: not a readable {kind} file (corrupt, truncated or another format"
+                       f"{': ' + why if why else ''})")
     if shape is None or shape.IsNull():
-        raise CadError(f"{path}: the {kind} file holds no shape")
+        raise CadError(f"{shown}: the {kind} file holds no shape")
     return shape
+
+
+@contextlib.contextmanager
+def _utf8_name(path: Path):
+    """A name OpenCascade takes for ``path``: itself, or (for a name that is not UTF-8, which its
+    bindings cannot pass) a link to it with a plain name in a private temporary folder."""
+    name = os.fsdecode(path)
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:
+        with tempfile.TemporaryDirectory(prefix="patterns-") as tmp:
+            link = os.path.join(tmp, "part" + path.suffix.lower())
+            os.symlink(os.path.abspath(path), link)
+            yield link
+        return
+    yield name
+
+
+@contextlib.contextmanager
+def _native_stdout():
+    """Catch what native code (OpenCascade) prints on file descriptor 1; yields a list that holds it after."""
+    import ctypes
+
+    said: list = []
+    fd = 1  # where std::cout writes, whatever Python's sys.stdout is now
+    with contextlib.suppress(AttributeError, OSError, ValueError):
+        sys.stdout.flush()
+    saved = os.dup(fd)
+    libc = ctypes.CDLL(None)
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), fd)
+        try:
+            yield said
+        finally:
+            libc.fflush(None)
+            os.dup2(saved, fd)
+            os.close(saved)
+            tmp.seek(0)
+            said.append(tmp.read().decode("utf-8", errors="replace"))
+
+
+def _first_complaint(said: list) -> str:
+    """OpenCascade's first message, without its colours and stars."""
+    text = re.sub(r"\x1b\[[0-9;]*m", "", "".join(said))
+    for line in text.splitlines():
+        line = line.strip(" *\t")
+        if line:
+            return line[:160]
+    return ""
 
 
 def _weld(value, option):
@@ -245,6 +366,10 @@ class LoadOptions(MeshingOptions):
     units: str = option("mm", "mesh files: the unit of the coordinates, converted to mm (CAD files are read in "
                               "mm whatever this says); on the command line also the unit of the DXF",
                         choices=UNIT_NAMES)
+    crease_angle: float = option(60.0, "mesh files: a closed piece (a box, a can) is split into panels along the "
+                                       "edges whose faces meet at more than this angle, degrees; a closed piece "
+                                       "with no such edge (a sphere) is refused", low=0, high=180, low_open=True,
+                                 metavar="DEG")
 
 
 def load(source, options: LoadOptions | None = None, **keywords):
@@ -286,28 +411,32 @@ def load(source, options: LoadOptions | None = None, **keywords):
     if isinstance(source, (str, Path)):
         path = Path(source)
         suffix = path.suffix.lower()
+        shown = os.fsdecode(path)
         if suffix in CAD_SUFFIXES:
             if opts.weld_vertices is not None:
-                raise InputError(f"{path}: weld_vertices applies to mesh files only")
-            return mesh_shape(read_cad(path), name=path.name, **meshing)
+                raise InputError(f"{shown}: weld_vertices applies to mesh files only")
+            return mesh_shape(read_cad(path), name=printable(path.name), **meshing)
         if suffix in MESH_SUFFIXES:
             if opts.panels is not None:
-                raise InputError(f"{path}: panels (groups of CAD faces) apply to CAD files only")
+                raise InputError(f"{shown}: panels (groups of CAD faces) apply to CAD files only")
             mesh = read_mesh(path, weld_vertices=opts.weld_vertices)
             scale = Unit(opts.units).mm
-            model = mesh_model(mesh.vertices * scale if scale != 1.0 else mesh.vertices, mesh.faces, name=path.name)
+            model = mesh_model(mesh.vertices * scale if scale != 1.0 else mesh.vertices, mesh.faces,
+                               name=printable(path.name), crease_angle=opts.crease_angle)
             return replace(model, bookkeeping=replace(model.bookkeeping, welded=mesh.n_welded,
-                                                      unused=mesh.n_unused))
+                                                      unused=mesh.n_unused, units=opts.units))
+        if path.is_dir():
+            raise InputError(f"{shown}: is a folder; give a CAD or mesh file")
         if not path.exists():
-            raise InputError(f"{path}: no such file")
-        raise InputError(f"{path}: unknown file type {suffix or '(none)'!r}; expected a CAD file "
+            raise InputError(f"{shown}: no such file")
+        raise InputError(f"{shown}: unknown file type {suffix or '(none)'!r}; expected a CAD file "
                          f"({', '.join(CAD_SUFFIXES)}) or a mesh file ({', '.join(MESH_SUFFIXES)})")
     if hasattr(source, "wrapped"):
         return mesh_shape(source, name=type(source).__name__, **meshing)
     raise InputError(f"cannot load a {type(source).__name__}: give a file path or a build123d shape")
 
 
-def mesh_model(vertices, faces, *, name: str = "mesh"):
+def mesh_model(vertices, faces, *, name: str = "mesh", crease_angle: float = 60.0):
     """A :class:`Model` from a triangle mesh: one panel per connected piece, cut open where needed.
 
     Parameters
@@ -315,28 +444,74 @@ def mesh_model(vertices, faces, *, name: str = "mesh"):
     vertices : (n, 3) float, mm
     faces : (m, 3) int
     name : str
+    crease_angle : float
+        A closed piece (a box, a can: no boundary at all) is split into panels
+        along its creases, the edges whose faces meet at more than this many
+        degrees; the creases become seams.  A closed piece without such
+        creases (a sphere) is refused: one cut cannot lay it flat.
 
     Returns
     -------
     Model
-        Panels ``piece0``, ``piece1``, ... in order of their first face;
-        seams are the cuts (``cad_edge`` None, both sides on one panel).
+        Panels ``piece0``, ``piece1``, ... in order of their first face (a
+        closed piece split along its creases: ``piece0.0``, ``piece0.1``,
+        ...); seams are the cuts made to open tubes (``cad_edge`` None, both
+        sides on one panel) and the creases.
+
+    Raises
+    ------
+    MeshTopologyError
+        A closed piece without creases, or one still closed after splitting;
+        a piece with handles; a non-manifold or inconsistently wound piece.
+    InputError
+        Bad arrays; more than :data:`~patterns.mesh.MAX_TRIANGLES` triangles.
     """
 
     v, f = as_mesh_arrays(vertices, faces, name=name)
-    panels, seams = [], []
+    if len(f) > MAX_TRIANGLES:
+        raise InputError(f"{name}: {len(f)} triangles, over the limit of {MAX_TRIANGLES:.0e}; decimate the mesh "
+                         f"or split it into parts")
+    check_faces_have_area(v, f, name=name)
+    panels, seams, cuts, split = [], [], 0, 0
     groups = pieces(f, len(v), name=name)
     for i, group in enumerate(groups):
-        label = f"piece{i}"
-        pname = name if len(groups) == 1 else f"{name}: {label}"
-        pv, pf, _ = drop_unused(v, f[group])
-        cut = cut_to_disk(pv, pf, name=pname)
-        panels.append(panel_from_mesh(label, cut.vertices, cut.faces, name=pname))
-        for path, (left, right) in zip(cut.paths, cut.sides):
-            points = pv[path]
-            seams.append(Seam(id=len(seams), panels=(i, i), points=points, vertices=(left, right),
-                              length=polyline_length(points)))
+        pname = name if len(groups) == 1 else f"{name}: piece{i}"
+        used = unique_ints(f[group])
+        regions = [np.arange(len(group))]
+        local = np.searchsorted(used, f[group])  # the piece's faces on its own vertices
+        if is_closed(local, len(used), name=pname):
+            regions = crease_pieces(v[used], local, angle=crease_angle, name=pname)
+            if len(regions) == 1:
+                cut_to_disk(v[used], local, name=pname)  # a torus: refused for its handles first
+                raise MeshTopologyError(
+                    f"{pname}: a closed surface with no crease sharper than {crease_angle:g} degrees (a sphere, a "
+                    f"blob): no single cut lays it flat without gross distortion; give it seams (split it into "
+                    f"panels, e.g. two domes) or a lower crease_angle")
+            split += 1
+        first = len(panels)
+        maps = []
+        for r, region in enumerate(regions):
+            label = f"piece{i}" if len(regions) == 1 else f"piece{i}.{r}"
+            rname = pname if len(regions) == 1 else f"{pname}.{r}"
+            rv = unique_ints(local[region])
+            rf = np.searchsorted(rv, local[region])
+            if len(regions) > 1 and is_closed(rf, len(rv), name=rname):
+                raise MeshTopologyError(f"{rname}: still closed after splitting along its creases; give it seams")
+            cut = cut_to_disk(v[used][rv], rf, name=rname)
+            panels.append(panel_from_mesh(label, cut.vertices, cut.faces, name=rname))
+            maps.append(rv)
+            for path, (left, right) in zip(cut.paths, cut.sides):
+                points = v[used][rv][path]
+                seams.append(Seam(id=len(seams), panels=(len(panels) - 1,) * 2, points=points,
+                                  vertices=(left, right), length=polyline_length(points)))
+                cuts += 1
+        if len(regions) > 1:
+            for a, b, path in shared_chains(local, regions):
+                points = v[used][path]
+                sides = tuple(np.searchsorted(maps[r], path) for r in (a, b))
+                seams.append(Seam(id=len(seams), panels=(first + a, first + b), points=points, vertices=sides,
+                                  length=polyline_length(points)))
     edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     longest = float(np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1).max())
     return Model(name=name, panels=tuple(panels), seams=tuple(seams), max_edge=longest,
-                 bookkeeping=Bookkeeping(cuts=len(seams)))
+                 bookkeeping=Bookkeeping(cuts=cuts, split=split))

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["UNIT_NAMES", "Unit"]
+__all__ = ["LARGEST_LENGTH", "UNIT_NAMES", "Unit"]
 
 
 class Unit(str, Enum):
@@ -43,3 +43,9 @@ class Unit(str, Enum):
 
 UNIT_NAMES = tuple(u.value for u in Unit)
 """``("mm", "cm", "m", "in")``."""
+
+
+LARGEST_LENGTH = 1e7
+"""The largest length `patterns` takes, mm (10 km): every coordinate of a part and every length
+option.  Beyond it a part is in the wrong unit, or its numbers are garbage; bounding them keeps
+every area and squared distance far from overflow."""

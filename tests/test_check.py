@@ -5,6 +5,7 @@ import json
 
 import numpy as np
 import pytest
+import shapely
 
 import patterns
 from patterns import surfaces
@@ -204,8 +205,9 @@ def test_json_report_round_trips_with_its_schema(cup, tmp_path):
     path = tmp_path / "cup.json"
     report.to_json(path)
     doc = json.loads(path.read_text())
-    assert doc["schema"] == "patterns.report/3" and doc["ok"] is False and doc["pattern"] == "cup.step"
-    assert doc["limits"] == {"max_strain": 0.03, "max_seam_mismatch": None}
+    assert doc["schema"] == "patterns.report/4" and doc["ok"] is False and doc["pattern"] == "cup.step"
+    assert doc["limits"] == {"max_strain": 0.03, "max_seam_mismatch": None, "area_tolerance": 0.05,
+                             "max_distortion": 2.0}
     assert [p["name"] for p in doc["panels"]] == ["face0", "face1", "face2", "face3"]
     for p, numbers in zip(doc["panels"], report.panels):
         assert p["strain_rms"] == numbers.strain_rms and p["area_3d"] == numbers.area_3d
@@ -342,6 +344,32 @@ def test_a_misplaced_hole_is_a_finding(holed, shift, code):
     assert code not in _codes(pattern)
 
 
+def test_a_panel_laid_at_the_wrong_size_is_not_usable(cup):
+    """Scaled by 0.9 (the flat piece 19 % smaller than the surface it is cut for) a panel is an error
+    whatever limit was asked; the message's change is the shapely area of the scaled outline against
+    the surface's area.  Stretched 2.2 times one way and squeezed as much the other (the area kept)
+    it is grossly distorted instead."""
+    flat = cup.panels[0]
+    small = _with_uv(cup, 0, flat.uv * 0.9)
+    (found,) = [f for f in patterns.check(small).findings if f.code is Code.AREA_NOT_KEPT]
+    area_3d = float(np.sum(np.linalg.norm(np.cross(*(flat.vertices[flat.faces[:, k]] - flat.vertices[flat.faces[:, 0]]
+                                                        for k in (1, 2))), axis=1)) / 2)
+    change = shapely.Polygon(flat.uv[flat.loops[0]] * 0.9).area / area_3d - 1
+    assert found.severity is Severity.ERROR and found.panels == (flat.name,)
+    assert f"is {abs(change):.1%} smaller than its 3D area" in found.message
+    assert Code.AREA_NOT_KEPT not in _codes(cup) and not patterns.check(small).ok
+    assert Code.AREA_NOT_KEPT not in _codes(_with_uv(cup, 0, flat.uv * 0.99))  # 2 % smaller: within 5 %
+    assert Code.AREA_NOT_KEPT not in {f.code for f in patterns.check(small, area_tolerance=None).findings}
+    skewed = _with_uv(cup, 0, flat.uv * [2.2, 1 / 2.2])
+    codes = _codes(skewed)
+    assert Code.GROSSLY_DISTORTED in codes and Code.AREA_NOT_KEPT not in codes
+    (gross,) = [f for f in patterns.check(skewed).findings if f.code is Code.GROSSLY_DISTORTED]
+    assert "100.0% of its area is laid flat at more than 2 times its size" in gross.message
+    assert len(gross.faces) == len(flat.faces)
+    assert Code.GROSSLY_DISTORTED not in _codes(_with_uv(cup, 0, flat.uv * [1.7, 1 / 1.7]))  # x 1.7 x its 12 %: < 2
+    assert Code.GROSSLY_DISTORTED not in _codes(cup)
+
+
 def test_a_relaxation_stopped_early_is_a_note(cup):
     short = patterns.flatten(cup.model, max_iterations=2)
     found = [f for f in patterns.check(short).findings if f.code is Code.NOT_CONVERGED]
@@ -375,7 +403,7 @@ def test_the_json_report_is_the_documented_schema(cup, tmp_path):
     text = path.read_text(encoding="utf-8")
     got = json.loads(text)
     assert list(got) == list(example)  # the same keys, in the documented order
-    assert text.startswith('{\n  "schema": "patterns.report/3",\n  "pattern": "cup.step"') and text.endswith("}\n")
+    assert text.startswith('{\n  "schema": "patterns.report/4",\n  "pattern": "cup.step"') and text.endswith("}\n")
     assert got["units"] == example["units"] and got["limits"] == example["limits"]
     for key in ("panels", "seams", "findings"):
         assert set(got[key][0]) == set(example[key][0]), key

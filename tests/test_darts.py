@@ -110,7 +110,7 @@ def test_the_report_and_the_dxf_list_every_dart(hemisphere, tmp_path):
         assert row.tip == pytest.approx(tuple(flat.uv[dart.tip]))
     report.to_json(tmp_path / "report.json")
     doc = json.loads((tmp_path / "report.json").read_text())
-    assert doc["schema"] == "patterns.report/3"
+    assert doc["schema"] == "patterns.report/4"
     assert [d["legs_flat"] for d in doc["panels"][0]["darts"]] == [list(d.legs_flat) for d in darts]
     assert [d["tip"] for d in doc["panels"][0]["darts"]] == [list(d.tip) for d in darts]
     (note,) = [f for f in report.findings if f.code is patterns.Code.DARTS]
@@ -236,7 +236,10 @@ def test_real_readers_read_the_darted_pattern(cup_darts, tmp_path):
                           capture_output=True, text=True, env=_qt_env(tmp_path), timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     found = json.loads(proc.stdout.strip().splitlines()[-1])
-    assert found["entities"]["CUT"] == {"contours": len(cup_darts.panels), "closed": len(cup_darts.panels)}
+    n = len(cup_darts.panels)
+    assert found["entities"]["CUT"]["contours"] == found["entities"]["CUT"]["closed"] == n
+    outlines = sorted(ring_numbers(flat.uv[flat.loops[0]])[0] for flat in cup_darts.panels)
+    np.testing.assert_allclose(found["entities"]["CUT"]["areas"], outlines, rtol=1e-3)  # the darted outlines
     _need("freecadcmd")
     proc = subprocess.run(["freecadcmd", str(READERS / "freecad_layers.py")], capture_output=True, text=True,
                           env=dict(_qt_env(tmp_path), DXF=str(path)), timeout=300)

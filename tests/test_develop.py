@@ -124,10 +124,10 @@ def test_a_general_cone_unrolls_by_its_directrix(apex, samples, tol):
 def test_offsetting_small_triangles_moves_by_the_offset_along_the_normal():
     """A fine freeform mesh (triangles well under 1 mm^2): every vertex moves by exactly the
     offset, along the unit normal of the surface (a sphere: radially)."""
-    from patterns.flattening.develop import offset_along_normals
-    from patterns.model import Panel
-    from patterns.mesh import validate_mesh
     from patterns import surfaces
+    from patterns.flattening.develop import offset_along_normals
+    from patterns.mesh import validate_mesh
+    from patterns.model import Panel
 
     v, f = surfaces.spherical_cap(radius=5.0, half_angle=40.0, n_faces=2000)  # areas ~0.01 mm^2
     v, f, conn = validate_mesh(v, f)

@@ -111,28 +111,42 @@ def test_bad_files_library_and_command_line(tmp_path, name):
 
 
 def test_closed_surfaces_several_pieces_and_flipped_normals_are_handled(tmp_path):
-    # Not errors: a closed surface is cut open, pieces become panels, a mesh wound
-    # the other way round flattens mirrored -- still one-to-one.
+    # Not errors: a closed box is split along its edges, pieces become panels, a mesh wound
+    # the other way round flattens mirrored -- still one-to-one.  A closed smooth piece (a ball)
+    # is refused, naming the piece: one cut cannot lay it flat.
     ball = trimesh.creation.icosphere(subdivisions=2, radius=40.0)
     box = trimesh.creation.box(extents=(30, 20, 10))
     box.apply_translation((100, 0, 0))
-    both = trimesh.util.concatenate([ball, box])
+    tube = trimesh.creation.cylinder(radius=10, height=40, sections=32)
+    tube = trimesh.Trimesh(tube.vertices, tube.faces[np.abs(tube.face_normals[:, 2]) < 0.5])  # open ends
+    tube.apply_translation((0, 100, 0))
     path = tmp_path / "two.ply"
-    both.export(path)
+    trimesh.util.concatenate([box, tube]).export(path)
     pattern = patterns.flatten(patterns.load(path))
-    assert len(pattern.panels) == 2 and len(pattern.seams) == 2 and pattern.one_to_one
+    assert len(pattern.panels) == 7 and len(pattern.seams) == 13 and pattern.one_to_one  # 6 + the tube, cut once
+    trimesh.util.concatenate([box, ball]).export(path)
+    with pytest.raises(MeshTopologyError, match="two.ply: piece1: a closed surface with no crease"):
+        patterns.load(path)
     v, f = surfaces.paraboloid_dish(n_faces=500)
     flipped = patterns.flatten_mesh(v, f[:, ::-1])
     assert flipped.one_to_one and flipped.n_folded == 0
 
 
-@pytest.mark.parametrize("scale,offset", [(1e-9, 0.0), (1.0, 1e9), (1e6, 0.0)])
+@pytest.mark.parametrize("scale,offset", [(1e-9, 0.0), (1.0, 9e6), (1.6e4, 0.0)])
 def test_extreme_coordinates(scale, offset):
+    """A part of a micrometre, one 9 km from the origin, one 9.6 km across: the same strains."""
     v, f = surfaces.paraboloid_dish(diameter=600.0, sag=54.0, n_faces=1000)
     reference = patterns.flatten_mesh(v, f)
     result = patterns.flatten_mesh(v * scale + offset, f)
     assert result.one_to_one and np.all(np.isfinite(result.uv))
     assert result.distortion.edge_strain_rms == pytest.approx(reference.distortion.edge_strain_rms, rel=0.02, abs=1e-6)
+
+
+@pytest.mark.parametrize("scale,offset", [(1.0, 1.1e7), (1e6, 0.0)])
+def test_coordinates_beyond_ten_km_are_refused(scale, offset):
+    v, f = surfaces.paraboloid_dish(diameter=600.0, sag=54.0, n_faces=1000)
+    with pytest.raises(InputError, match="vertices lie beyond 1e\\+07 mm \\(10 km\\) of the origin"):
+        patterns.flatten_mesh(v * scale + offset, f)
 
 
 def test_meshing_limits_refuse_instead_of_hanging():

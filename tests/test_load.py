@@ -98,14 +98,48 @@ def test_the_model_carries_what_loading_did(tmp_path, capsys):
     assert f"{corners - len(v)} vertices welded" in capsys.readouterr().out
 
 
-def test_a_closed_mesh_reports_its_cut(tmp_path):
+def test_a_closed_smooth_mesh_is_refused_not_cut_once(tmp_path):
+    """A sphere has no line to cut it along, and no single cut lays it flat (Gauss-Bonnet: its
+    4 pi of curvature must go somewhere): refused, with the advice to give it seams."""
     import patterns
 
     sphere = trimesh.creation.icosphere(subdivisions=2, radius=50.0)
     path = tmp_path / "ball.obj"
     sphere.export(path)
+    with pytest.raises(patterns.MeshTopologyError, match="ball.obj: a closed surface with no crease.*give it seams"):
+        patterns.load(path)
+
+
+def test_a_closed_box_mesh_is_split_along_its_creases(tmp_path):
+    """A closed box (STL, as CAD exports a solid) comes in as its six faces, joined by its twelve
+    edges: each seam as long as the box edge it runs along."""
+    import patterns
+
+    path = tmp_path / "box.stl"
+    trimesh.creation.box((100.0, 60.0, 40.0)).export(path)
     model = patterns.load(path)
-    assert model.bookkeeping.cuts == 1 == sum(s.cad_edge is None for s in model.seams)
+    assert len(model.panels) == 6 and len(model.seams) == 12
+    assert sorted(round(s.length, 5) for s in model.seams) == [40.0] * 4 + [60.0] * 4 + [100.0] * 4
+    assert sorted(round(p.area, 3) for p in model.panels) == [2400.0] * 2 + [4000.0] * 2 + [6000.0] * 2
+    assert model.bookkeeping.split == 1 and model.bookkeeping.cuts == 0
+    assert "1 closed piece split into panels along creases" in str(model.bookkeeping)
+
+
+def test_a_closed_can_is_split_at_its_rims_and_its_side_cut_open(tmp_path):
+    import patterns
+
+    path = tmp_path / "can.stl"
+    trimesh.creation.cylinder(radius=30.0, height=80.0, sections=48).export(path)
+    model = patterns.load(path)
+    assert len(model.panels) == 3
+    rims = [s for s in model.seams if not s.closes_panel]
+    polygon = 48 * 2 * 30.0 * np.sin(np.pi / 48)  # the 48-gon's perimeter
+    assert [s.length for s in rims] == pytest.approx([polygon, polygon], rel=1e-6)  # STL: float32
+    (cut,) = [s for s in model.seams if s.closes_panel]  # the side, a tube, cut along its height
+    assert cut.length == pytest.approx(80.0, rel=1e-6)
+    assert model.bookkeeping.cuts == 1
+    pattern = patterns.flatten(model)
+    assert patterns.check(pattern).ok
 
 
 @pytest.mark.parametrize(("unit", "mm"), [("mm", 1.0), ("cm", 10.0), ("m", 1000.0), ("in", 25.4)])

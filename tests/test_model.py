@@ -159,23 +159,22 @@ def test_bad_meshing_options(option):
         patterns.load(bd.Box(10, 10, 10), **option)
 
 
-def test_closed_mesh_is_cut_open_and_the_cut_reported(tmp_path):
+def test_closed_mesh_is_refused_but_the_kernel_can_slit_it(tmp_path):
+    """Loading refuses a closed smooth surface (one cut cannot lay it flat: docs/loading.md); the
+    kernel that opens tubes still slits it into a disk, and the engine lays that disk out one-to-one."""
     sphere = trimesh.creation.icosphere(subdivisions=3, radius=50.0)
     path = tmp_path / "ball.stl"
     sphere.export(path)
-    model = patterns.load(path)
-    assert len(model.panels) == 1 and len(model.seams) == 1
-    seam = model.seams[0]
-    assert seam.cad_edge is None and seam.closes_panel
-    left, right = seam.vertices
-    panel = model.panels[0]
+    with pytest.raises(patterns.MeshTopologyError, match="closed surface"):
+        patterns.load(path)
+    cut = patterns.cut_to_disk(sphere.vertices, sphere.faces)
+    (path_,), ((left, right),) = cut.paths, cut.sides
     # Both sides carry the same points; inside the slit the copies differ.
-    np.testing.assert_array_equal(panel.vertices[left], seam.points)
-    np.testing.assert_array_equal(panel.vertices[right], seam.points)
+    np.testing.assert_array_equal(cut.vertices[left], sphere.vertices[path_])
+    np.testing.assert_array_equal(cut.vertices[right], sphere.vertices[path_])
     assert left[0] == right[0] and left[-1] == right[-1] and np.all(left[1:-1] != right[1:-1])
-    assert seam.length > 50.0  # between two far-apart vertices of a 50 mm ball
-    pattern = patterns.flatten(model)
-    assert pattern.one_to_one and independent_one_to_one(pattern.panels[0].faces, pattern.panels[0].uv)
+    result = patterns.flatten_mesh(cut.vertices, cut.faces)
+    assert result.overlap.one_to_one and independent_one_to_one(cut.faces, result.uv)
 
 
 def test_a_tube_is_cut_but_a_plate_with_a_hole_is_not(tmp_path):
@@ -213,10 +212,12 @@ def test_mesh_pieces_become_panels(tmp_path):
     path = tmp_path / "two.off"
     trimesh.util.concatenate([a, b]).export(path)
     model = patterns.load(path)
-    assert [p.name for p in model.panels] == ["piece0", "piece1"]
-    assert len(model.seams) == 2  # each closed box cut open once
+    # two pieces, each a closed box: split along its twelve edges into its six faces
+    assert [p.name for p in model.panels] == [f"piece{i}.{k}" for i in range(2) for k in range(6)]
+    assert len(model.seams) == 24 and all(s.length == pytest.approx(10.0) for s in model.seams)
+    assert all(s.panels[0] // 6 == s.panels[1] // 6 for s in model.seams)  # a seam stays within its box
     pattern = patterns.flatten(model)
-    assert pattern.one_to_one
+    assert pattern.one_to_one and patterns.check(pattern).ok
 
 
 def test_3mf_is_read(tmp_path):

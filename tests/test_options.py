@@ -92,7 +92,7 @@ CLI_VALUES = [  # (flag and text, record, the API's keyword and value)
     (["--units", "in"], "dxf", "units", "in"),
     (["--method", "isometric"], "flatten", "method", "isometric"),
     (["--no-exact"], "flatten", "exact", False),
-    (["--grain", "0,0,2"], "flatten", "grain", (0.0, 0.0, 2.0)),
+    (["--grain", "0,0,2"], "flatten", "grain", (0.0, 0.0, 1.0)),  # a direction, normalised
     (["--ease", "0:face0:2%"], "flatten", "ease", (patterns.Ease(0, "face0", ratio=0.02),)),
     (["--dart-strain", "0.03"], "flatten", "max_strain", 0.03),
     (["--max-darts", "7"], "flatten", "max_darts", 7),
@@ -122,9 +122,9 @@ def test_a_flag_makes_the_record_the_api_makes(argv, key, name, value):
 @pytest.mark.parametrize(("flag", "text", "message"), [
     ("--max-darts", "-1", "max_darts must be an integer >= 0, got -1"),
     ("--k-factor", "1.5", "k_factor must be a number between 0 and 1, got 1.5"),
-    ("--text-height", "inf", "text_height must be a positive number, got inf"),
+    ("--text-height", "inf", "text_height must be a positive number <= 1e+07, got inf"),
     ("--max-strain", "0", "max_strain must be a positive number, got 0"),
-    ("--chord-tolerance", "nan", "chord_tolerance must be a positive number, got nan"),
+    ("--chord-tolerance", "nan", "chord_tolerance must be a positive number <= 1e+07, got nan"),
 ])
 def test_a_bad_flag_fails_in_one_line_before_loading(tmp_path, capsys, flag, text, message):
     """The CLI's refusal is the API's message, given before the (missing) input is even read."""

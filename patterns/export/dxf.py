@@ -18,17 +18,18 @@ import shapely
 from shapely.geometry.polygon import orient
 
 from ..errors import InputError
-from ..files import atomic_output
+from ..files import atomic_output, output_target
 from ..measure import strain_stats, triangle_strains
 from ..mesh import polyline_arc
 from ..options import Options, check_number, is_number, option
+from ..text import printable
 from ..units import UNIT_NAMES, Unit
 from .arcs import fit_arcs
 from .heatmap import display_offsets
 from .labels import LabelPlacer, along
 
-__all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "PROFILES", "DxfOptions", "seam_label",
-           "write_outline_dxf", "write_pattern_dxf"]
+__all__ = ["ASTM_LAYERS", "MACHINE_LAYERS", "MACHINE_VERSIONS", "MAX_MARKS", "PROFILES", "DxfOptions", "check_marks",
+           "seam_label", "write_outline_dxf", "write_pattern_dxf"]
 
 
 def write_outline_dxf(path, loops: Sequence[np.ndarray], *, units: str = "mm", layer: str = "CUT") -> None:
@@ -89,12 +90,17 @@ MACHINE_VERSIONS = {"R12": "AC1009", "R2000": "AC1015", "R2004": "AC1018", "R200
 """DXF versions the machine profile writes, and their ``$ACADVER``."""
 
 
+MAX_SEAM_ALLOWANCE = 1000.0
+"""The largest seam allowance, mm: a metre of cloth or sheet outside the seam line is not an allowance."""
+
+
 def _seam_allowance(value, option):
-    """A number (mm, >= 0) or a mapping ``{seam id or None: mm}``, checked (seam ids against the pattern later)."""
+    """A number (mm, 0..1000) or a mapping ``{seam id or None: mm}``, checked (seam ids against the pattern later)."""
     if hasattr(value, "items"):
-        return dict((key, check_number(mm, f"{option}[{key!r}] (mm)", low=0)) for key, mm in value.items())
+        return {key: check_number(mm, f"{option}[{key!r}] (mm)", low=0, high=MAX_SEAM_ALLOWANCE)
+                for key, mm in value.items()}
     if is_number(value):
-        return check_number(value, f"{option} (mm)", low=0)
+        return check_number(value, f"{option} (mm)", low=0, high=MAX_SEAM_ALLOWANCE)
     raise InputError(f"{option} must be a number (mm) or a mapping of seam ids to mm, got {type(value).__name__}")
 
 
@@ -108,7 +114,7 @@ class DxfOptions(Options):
     seam_allowance: float | dict = option(0.0, "seam allowance added outside the seam line, mm: one number for every "
                                          "edge, or (API) a mapping {seam id: mm, None: mm for every other edge}; "
                                          "the seam line then goes on SEW (ASTM layer 14)",
-                                    check=_seam_allowance, parse=float, metavar="MM")
+                                    check=_seam_allowance, parse=float, unit="mm")
     units: str = option("mm", "unit of the drawing (machine profile; ASTM is mm); also, on the command line, "
                               "the unit of a mesh file's coordinates", choices=UNIT_NAMES)
     version: str | None = option(None, "machine profile: DXF version (default R2000; ASTM is R12)",
@@ -116,18 +122,18 @@ class DxfOptions(Options):
     strain_layer: bool = option(False, "machine profile: the strain heat map as filled triangles on layer STRAIN "
                                        "(true colour from R2004)")
     text_height: float | None = option(None, "label height, mm (default 3 % of each panel's size, 2-12 mm)",
-                                       low=0, low_open=True, optional=True, metavar="MM")
+                                       low=0, low_open=True, optional=True, unit="mm")
     gap: float | None = option(None, "space between panels when the pattern is not laid out, mm",
-                               low=0, optional=True, metavar="MM")
+                               low=0, optional=True, unit="mm")
     arcs: bool = option(False, "machine profile: cut contours as arcs and lines fitted within arc_tolerance")
     arc_tolerance: float = option(0.01, "largest distance of the fitted arcs from the contour, mm",
-                                  low=0, low_open=True, metavar="MM")
+                                  low=0, low_open=True, unit="mm")
     bend_spacing: float | None = option(None, "draw the rulings of exactly developed cylinders and cones about "
                                               "this far apart (mm) on BEND with their bend angles",
-                                        low=0, low_open=True, optional=True, metavar="MM")
+                                        low=0, low_open=True, optional=True, unit="mm")
     notch_spacing: float | None = option(None, "matching notches along every seam every this many mm of 3D "
                                                "length, on both panels (default: at the seam ends only)",
-                                         low=0, low_open=True, optional=True, metavar="MM")
+                                         low=0, low_open=True, optional=True, unit="mm")
     notch_style: str = option("slit", "notch shape: a slit across the seam allowance, or a V", choices=NOTCH_STYLES)
     seam_corners: str = option("mitre", "corners of the seam allowance: offset lines meeting at a point (mitre), "
                                         "or each side's allowance run straight on past the corner (square)",
@@ -166,7 +172,7 @@ class _PanelGeometry:
     def __init__(self, pattern, index, offset, allowances, text_height, corners="mitre"):
 
         flat = pattern.panels[index]
-        self.name = flat.name
+        self.name = printable(flat.name)  # names are data: no control character reaches the file
         self.index = index
         uv = np.asarray(flat.uv) + offset
         self.uv = uv
@@ -536,6 +542,9 @@ def write_pattern_dxf(pattern, path, options: DxfOptions | None = None, **keywor
     import ezdxf
 
     opts = DxfOptions.of(options, keywords, name=str(path))
+    check_marks(pattern.name, [fs.seam.length for fs in pattern.seams],
+                [float(np.ptp(flat.uv, axis=0).max()) for flat in pattern.panels], opts)
+    output_target(path, what="DXF file")  # before the drawing: a path that cannot be written fails at once
     allowance_of = _allowance_lookup(opts.seam_allowance, {s.seam.id for s in pattern.seams}, path)
     biggest = max(float(np.max(_allowance_values(pattern, allowance_of))), 0.0)
     offsets = display_offsets(pattern, gap=opts.gap, margin=biggest)
@@ -555,6 +564,48 @@ def write_pattern_dxf(pattern, path, options: DxfOptions | None = None, **keywor
         _first_quadrant(doc, MARGIN)
         with atomic_output(path, what="DXF file") as tmp:
             _export_astm(gerber_D6673, doc, tmp)
+
+
+MAX_MARKS = 100_000
+"""The most notches, and the most bend lines, one DXF file gets: a spacing that would draw more
+(a notch every 0.1 mm) is refused before anything is drawn."""
+
+
+SMALLEST_PANEL = 0.01
+"""The smallest panel drawn, mm across: ten times the 0.001 mm to which straight runs are drawn."""
+
+
+def check_marks(name: str, seam_lengths, panel_sizes, options: DxfOptions) -> None:
+    """InputError when a panel is too small to draw (:data:`SMALLEST_PANEL`), or when ``notch_spacing`` or
+    ``bend_spacing`` would draw more than :data:`MAX_MARKS` marks.
+
+    Parameters
+    ----------
+    name : str
+        The part, for the message.
+    seam_lengths : sequence of float
+        Every seam's 3D length, mm (a notch every ``notch_spacing`` on each side).
+    panel_sizes : sequence of float
+        Every panel's largest extent, mm (a bend line every ``bend_spacing`` across it, at most).
+    options : DxfOptions
+    """
+    small = [size for size in panel_sizes if not size >= SMALLEST_PANEL]
+    if small:
+        raise InputError(f"{name}: a panel {small[0]:.3g} mm across, under the {SMALLEST_PANEL:g} mm a DXF draws "
+                         f"a panel at (parts are read in mm: check the file's unit)")
+    total = float(np.sum(seam_lengths)) if len(seam_lengths) else 0.0
+    if options.notch_spacing:
+        notches = 2 * (total / options.notch_spacing + len(seam_lengths))
+        if notches > MAX_MARKS:
+            raise InputError(f"{name}: notch_spacing {options.notch_spacing:g} mm would draw about {notches:.3g} "
+                             f"notches along {total:.0f} mm of seams; at most {MAX_MARKS} are drawn: give a larger "
+                             f"spacing")
+    if options.bend_spacing:
+        lines = float(np.sum(panel_sizes)) / options.bend_spacing if len(panel_sizes) else 0.0
+        if lines > MAX_MARKS:
+            raise InputError(f"{name}: bend_spacing {options.bend_spacing:g} mm would draw up to {lines:.3g} bend "
+                             f"lines across {len(panel_sizes)} panels; at most {MAX_MARKS} are drawn: give a "
+                             f"larger spacing")
 
 
 MARGIN = 5.0
@@ -833,7 +884,8 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
                 block.add_line(tuple(a + offsets[g.index]), tuple(b + offsets[g.index]), dxfattribs={"layer": "8"})
         th = g.text_height
         placer = LabelPlacer(g.polygon)
-        lines = [f"Piece Name:{g.name}", f"Size:{SAMPLE_SIZE}", "Quantity:1", "Material:", f"Style Name:{pattern.name}",
+        lines = [f"Piece Name:{g.name}", f"Size:{SAMPLE_SIZE}", "Quantity:1", "Material:",
+                 f"Style Name:{printable(pattern.name)}",
                  "Units:METRIC"]
         strain = f"STRAIN RMS {100 * g.strain_rms:.2f}% MAX {100 * g.strain_max:.2f}%"
         block_lines = [(s, 2.0 - k, 0.6) for k, s in enumerate(lines)] + [(strain, -5.0, 0.6)]
@@ -854,7 +906,7 @@ def _astm_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
     top = max(float(np.max(loop[:, 1])) for g in geos for loop in g.cut_loops)
     left = min(float(np.min(loop[:, 0])) for g in geos for loop in g.cut_loops)
     th = geos[0].text_height
-    style = [ASTM_VERSION, f"Style Name:{pattern.name}", f"Creation Date:{_creation_date()}", "Author:patterns",
+    style = [ASTM_VERSION, f"Style Name:{printable(pattern.name)}", f"Creation Date:{_creation_date()}", "Author:patterns",
              f"Sample Size:{SAMPLE_SIZE}", "Grading Rule Table:", "Units:METRIC"]
     for k, line in enumerate(style):  # the version line on top
         msp.add_text(line, height=0.6 * th, dxfattribs={"layer": "1"}).set_placement(

@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import InputError
 from ..files import atomic_output
 from ..options import check_number
+from ..text import printable
 
 __all__ = ["HEAT_MAP_FORMATS", "display_offsets", "heat_map"]
 
@@ -101,7 +102,7 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
             ring = uv[np.r_[loop, loop[:1]]]
             ax.plot(ring[:, 0], ring[:, 1], color="black", linewidth=0.8)
         centre = uv[flat.loops[0]].mean(axis=0)
-        ax.annotate(flat.name, centre, ha="center", va="center", fontsize=9,
+        ax.annotate(printable(flat.name), centre, ha="center", va="center", fontsize=9, parse_math=False,
                     bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.7, "linewidth": 0})
     segments = []
     for fs in pattern.seams:
@@ -116,8 +117,9 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
     ax.set_aspect("equal")
     ax.set_xlabel("mm")
     ax.set_ylabel("mm")
-    ax.set_title(title if title is not None else
-                 f"{pattern.name}: strain RMS {rms:.2%}, largest {worst:.2%} (dashed: seams)")
+    ax.set_title(printable(title) if title is not None else
+                 f"{printable(pattern.name)}: strain RMS {rms:.2%}, largest {worst:.2%} (dashed: seams)",
+                 parse_math=False)  # names are data: "$x$" stays the text it is
     bar = fig.colorbar(mappable, ax=ax, shrink=0.8, extend="both" if worst > limit else "neither")
     bar.set_label("strain, %  (blue: flat shorter than the surface, red: longer)")
     with atomic_output(path, what="heat map") as tmp:

@@ -108,10 +108,9 @@ class LabelPlacer:
         from shapely.ops import polylabel
 
         x0, y0, x1, y1 = self.piece.bounds
+        step = max(step, max(x1 - x0, y1 - y0) / 150)  # a large piece: a coarser grid, some 20000 points at most
         xs, ys = np.arange(x0, x1 + step, step), np.arange(y0, y1 + step, step)
         grid = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
-        if len(grid) > 20000:  # a large piece: a coarser grid
-            grid = grid[:: int(np.ceil(len(grid) / 20000))]
         grid = grid[shapely.contains_xy(self.piece, grid[:, 0], grid[:, 1])]
         grid = grid[np.argsort(np.linalg.norm(grid - near, axis=1))][:limit]
         pole = np.array(polylabel(self.piece, tolerance=max(step / 4, 1e-3)).coords[0])

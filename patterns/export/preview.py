@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import InputError
 from ..files import atomic_output
 
@@ -19,7 +21,15 @@ PREVIEW_FORMATS = (".png", ".svg")
 """File suffixes :func:`preview_dxf` writes."""
 
 
-def preview_dxf(dxf_path, out_path, *, dpi: int = 96, margin: float = 10.0) -> None:
+MAX_PIXELS = 40_000_000
+"""The most pixels a PNG preview has (40 megapixels, about 160 MB while drawn): a larger drawing is
+rendered at a lower resolution, stored in the file, so that it still prints at 1:1."""
+
+_MM_PER_UNIT = {1: 25.4, 4: 1.0, 5: 10.0, 6: 1000.0}
+"""``$INSUNITS`` to millimetres per drawing unit (unitless files are taken as mm)."""
+
+
+def preview_dxf(dxf_path, out_path, *, dpi: float = 96, margin: float = 10.0) -> float:
     """Render a DXF file to a PNG or SVG at 1:1 (millimetres).
 
     Parameters
@@ -28,10 +38,19 @@ def preview_dxf(dxf_path, out_path, *, dpi: int = 96, margin: float = 10.0) -> N
         A DXF file (read with ezdxf's ``recover``, as a tolerant reader would).
     out_path : str or Path
         ``.png`` or ``.svg``; written atomically.
-    dpi : int
-        PNG resolution: 1 mm is ``dpi / 25.4`` pixels.
+    dpi : float
+        PNG resolution: 1 mm is ``dpi / 25.4`` pixels -- lowered for a drawing
+        that would take more than :data:`MAX_PIXELS` (the resolution used is
+        stored in the PNG and returned).
     margin : float
         White border around the drawing, mm.
+
+    Returns
+    -------
+    float
+        The PNG's resolution, dots per inch (``dpi``, or lower for a large
+        drawing); 0 for an SVG.  Either prints at 1:1: the drawing's unit
+        (``$INSUNITS``: mm, cm, m or inches) is honoured.
 
     Raises
     ------
@@ -64,25 +83,31 @@ def preview_dxf(dxf_path, out_path, *, dpi: int = 96, margin: float = 10.0) -> N
     extents = bbox.extents(msp)
     if not extents.has_data:
         raise InputError(f"{dxf_path}: the DXF file draws nothing")
+    unit = _MM_PER_UNIT.get(int(doc.header.get("$INSUNITS", 4) or 4), 1.0)
     if suffix == ".svg":
         backend = svg.SVGBackend()
         Frontend(RenderContext(doc), backend, config=config).draw_layout(msp)
         page = layout.Page(0, 0, layout.Units.mm, margins=layout.Margins.all(margin))
-        text = backend.get_string(page, settings=layout.Settings(fit_page=False, scale=1.0))
+        text = backend.get_string(page, settings=layout.Settings(fit_page=False, scale=unit))
         with atomic_output(out_path, what="preview") as tmp:
             tmp.write_text(text, encoding="utf-8")
-        return
+        return 0.0
     from ezdxf.addons.drawing.matplotlib import MatplotlibBackend
     from matplotlib.figure import Figure
 
-    width = extents.size.x + 2 * margin
-    height = extents.size.y + 2 * margin
+    width = extents.size.x * unit + 2 * margin  # mm on paper
+    height = extents.size.y * unit + 2 * margin
+    pixels = (width / 25.4 * dpi) * (height / 25.4 * dpi)
+    if pixels > MAX_PIXELS:
+        dpi = dpi * float(np.sqrt(MAX_PIXELS / pixels))
     fig = Figure(figsize=(width / 25.4, height / 25.4), dpi=dpi)
     ax = fig.add_axes((0, 0, 1, 1))
     ax.set_axis_off()
     Frontend(RenderContext(doc), MatplotlibBackend(ax), config=config).draw_layout(msp, finalize=False)
-    ax.set_xlim(extents.extmin.x - margin, extents.extmax.x + margin)
-    ax.set_ylim(extents.extmin.y - margin, extents.extmax.y + margin)
+    pad = margin / unit
+    ax.set_xlim(extents.extmin.x - pad, extents.extmax.x + pad)
+    ax.set_ylim(extents.extmin.y - pad, extents.extmax.y + pad)
     ax.set_aspect("equal")
     with atomic_output(out_path, what="preview") as tmp:
         fig.savefig(tmp, format="png", dpi=dpi, facecolor="white")
+    return float(dpi)

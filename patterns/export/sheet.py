@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import ExportError, InputError
 from ..files import atomic_output
+from ..text import printable
 from .dxf import _new_doc, _readable_angle, _save
 
 __all__ = ["write_blank_dxf"]
@@ -91,7 +92,7 @@ def write_blank_dxf(blank, path, *, text_height: float = 3.0, version: str = "R2
                      dxfattribs={"layer": "BEND"}).set_placement(tuple(at), align=centre)
     w, h = blank.size
     how = f"K {blank.k_factor:g}" if blank.k_factor is not None else "BEND TABLE"
-    label = f"{blank.name}  T {blank.thickness:g} MM  {how}  {w:.1f} x {h:.1f} MM"
+    label = f"{printable(blank.name)}  T {blank.thickness:g} MM  {how}  {w:.1f} x {h:.1f} MM"
     msp.add_text(label, height=text_height, dxfattribs={"layer": "LABEL"}).set_placement(
         (_MARGIN, _MARGIN + h + 1.5 * text_height), align=ezdxf.enums.TextEntityAlignment.BOTTOM_LEFT)
     with atomic_output(path, what="DXF file") as tmp:

@@ -61,7 +61,8 @@ def _direction(value, option):
         raise InputError(f"{option} must be a 3D direction (x, y, z), got {value!r}") from None
     if not np.all(np.isfinite(d)) or not np.any(d):
         raise InputError(f"{option} must be a non-zero 3D direction, got {value!r}")
-    return tuple(float(x) for x in d)
+    d = d / np.abs(d).max()  # a direction: its length does not matter (1e308, 1e308, 0 is (1, 1, 0))
+    return tuple(float(x) for x in d / np.linalg.norm(d))
 
 
 def _ease(value, option):
@@ -86,7 +87,7 @@ class FlattenOptions(Options):
     exact: bool = option(True, "unroll planar, cylindrical and conical CAD faces analytically (exact, strain 0); "
                                "the command line's --no-exact sends them through the mesh engine too")
     thickness: float = option(0.0, "sheet thickness, mm: develop the neutral surface, k_factor x thickness from "
-                                   "the inside skin", low=0, metavar="MM")
+                                   "the inside skin", low=0, unit="mm")
     k_factor: float = option(0.5, "position of the neutral surface from the inside skin, 0..1", low=0, high=1,
                              metavar="K")
     reference: str = option("mid", "which skin of the sheet the model shows", choices=REFERENCES)

@@ -127,10 +127,10 @@ class MeshingOptions(Options):
 
     max_edge: float | None = option(None, "CAD: target triangle edge length, mm (default: about 4000 triangles "
                                           "over the part, and at least about 1000 on every face)",
-                                    low=0, low_open=True, optional=True, metavar="MM")
+                                    low=0, low_open=True, optional=True, unit="mm")
     chord_tolerance: float = option(0.05, "CAD: largest distance from a triangle or segment to the true surface "
                                           "or edge, mm; curved faces get shorter edges to meet it; also the "
-                                          "sewing tolerance", low=0, low_open=True, metavar="MM")
+                                          "sewing tolerance", low=0, low_open=True, unit="mm")
     angular_tolerance: float = option(0.2, "CAD: largest angle between the normals at the two ends of a "
                                            "triangle edge, radians", low=0, low_open=True, metavar="RAD")
     panels: dict | None = option(None, "CAD: groups of CAD faces (indices in shape.faces() order) cut as one panel "

@@ -190,7 +190,38 @@ def _lattice(polygon, bnd: _Boundary, h: float) -> np.ndarray:
     seg_len = np.linalg.norm(bnd.xy[b] - bnd.xy[a], axis=1)
     tree = shapely.STRtree(lines)
     (_, near), dist = tree.query_nearest(shapely.points(interior), return_distance=True, all_matches=False)
-    return interior[dist >= 0.55 * np.maximum(h, seg_len[near])]
+    interior = interior[dist >= 0.55 * np.maximum(h, seg_len[near])]
+    tip = _tip_points(bnd, h)
+    if len(tip) and len(interior):
+        gap = np.linalg.norm(interior[:, None, :] - tip[None, :, :], axis=2).min(axis=1)
+        interior = interior[gap >= 0.5 * h]
+    return np.concatenate([interior, tip]) if len(tip) else interior
+
+
+def _tip_points(bnd: _Boundary, h: float) -> np.ndarray:
+    """Interior points (t, 2) in the narrow tip of a face around an apex (a cone's point).
+
+    There the face's seam line runs out from the apex on both sides of its
+    development -- the same 3D points twice, closer together than the lattice
+    can fill -- and a triangle between boundary points alone would have all
+    three on one straight line in 3D (zero area).  Across each pair of copies
+    narrower than ``2 h``, two points are put, at a third and two thirds of the
+    way, so that every triangle of the tip has a corner off the seam line.
+    """
+    out = []
+    for ring in bnd.rings:
+        ring = np.asarray(ring)
+        n = len(ring)
+        for i in range(n):
+            for k in range(1, n // 2):
+                left, right = ring[(i - k) % n], ring[(i + k) % n]
+                if bnd.slot_gid[left] != bnd.slot_gid[right]:
+                    break
+                a, b = bnd.xy[left], bnd.xy[right]
+                if np.linalg.norm(b - a) >= 2 * h:
+                    break
+                out += [a + (b - a) / 3, a + 2 * (b - a) / 3]
+    return np.array(out).reshape(-1, 2)
 
 
 def _triangulate(points: np.ndarray, polygon, nb: int, h: float, where: str) -> np.ndarray:

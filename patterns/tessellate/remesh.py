@@ -130,8 +130,9 @@ def flip_to_delaunay(xyz: np.ndarray, uv: np.ndarray, tri: np.ndarray, fixed: np
         for k in range(3):
             a = p[:, (k + 1) % 3] - p[:, k]
             b = p[:, (k + 2) % 3] - p[:, k]
-            cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-            angle[:, k] = np.arccos(np.clip(cos, -1.0, 1.0))
+            norms = np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
+            cos = np.einsum("ij,ij->i", a, b) / np.where(norms > 0, norms, 1.0)
+            angle[:, k] = np.arccos(np.clip(np.where(norms > 0, cos, 1.0), -1.0, 1.0))
         # Side k of a triangle: corners k+1 -> k+2, opposite corner k.
         side_a = tri[:, [1, 2, 0]].ravel()
         side_b = tri[:, [2, 0, 1]].ravel()
@@ -141,12 +142,15 @@ def flip_to_delaunay(xyz: np.ndarray, uv: np.ndarray, tri: np.ndarray, fixed: np
         pair = np.flatnonzero(ks[1:] == ks[:-1])
         h1, h2 = order[pair], order[pair + 1]  # the two half-edges of each interior edge
         viol = angle.ravel()[h1] + angle.ravel()[h2] - np.pi
-        ok = (viol > 1e-9) & ~np.isin(ks[pair], fixed_key)
         t1, c1 = h1 // 3, h1 % 3
         t2, c2 = h2 // 3, h2 % 3
         a, b = side_a[h1], side_b[h1]  # t1 = (.., a -> b, opposite c)
+        # An edge between two copies of one 3D point (the two sides of a slender cone's seam line
+        # near its apex, close in the development) makes both its triangles flat: flip it first.
+        viol = np.where(np.linalg.norm(xyz[a] - xyz[b], axis=1) > 0, viol, np.pi)
+        ok = (viol > 1e-9) & ~np.isin(ks[pair], fixed_key)
         c, d = tri[t1, c1], tri[t2, c2]
-        ok &= (orient(a, d, c) > 0) & (orient(d, b, c) > 0)
+        ok &= (orient(a, d, c) > 0) & (orient(d, b, c) > 0) & (np.linalg.norm(xyz[c] - xyz[d], axis=1) > 0)
         if not ok.any():
             break
         cand = np.flatnonzero(ok)

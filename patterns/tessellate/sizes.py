@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import CadError
+from ..mesh import MAX_TRIANGLES
 from .topology import Topology
 
 __all__ = ["DEFAULT_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "Development", "Sizes", "face_sizes"]
@@ -18,9 +19,6 @@ the whole shape's area (before curvature refines it)..."""
 MIN_FACE_TRIANGLES = 1000
 """... and each face at least about this many of its own."""
 
-MAX_TRIANGLES = 4_000_000
-"""Meshing that would make more triangles than this is refused (CadError) before it starts:
-a tiny ``max_edge`` or ``tolerance`` must not hang the machine."""
 
 _GRID = 41  # samples per parameter direction of a face's development table
 

@@ -12,8 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import CadError, InputError
+from ..units import LARGEST_LENGTH
 
-__all__ = ["Topology", "panel_groups", "read_topology", "sewn"]
+__all__ = ["Topology", "closed_panels", "panel_groups", "read_topology", "sewn"]
 
 
 class _Registry:
@@ -82,6 +83,7 @@ def read_topology(shape, *, name: str) -> Topology:
         ex.Next()
     if not faces:
         raise CadError(f"{name}: the shape has no faces (nothing to flatten)")
+    _check_extent(shape, name)
     # Edges numbered as build123d's ``shape.edges()`` does: explorer order,
     # degenerate edges left out -- here they come after all the others.
     edges = _Registry()
@@ -116,6 +118,35 @@ def read_topology(shape, *, name: str) -> Topology:
                     wires=tuple(wires), edge_faces=tuple(tuple(f) for f in edge_faces))
 
 
+def _check_extent(shape, name: str) -> None:
+    """InputError if the shape reaches beyond LARGEST_LENGTH of the origin (a wrong unit, or garbage)."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+
+    box = Bnd_Box()
+    BRepBndLib.Add_s(shape, box)
+    if box.IsVoid():
+        return
+    low, high = box.CornerMin(), box.CornerMax()
+    corners = np.array([low.X(), low.Y(), low.Z(), high.X(), high.Y(), high.Z()])
+    if not np.all(np.isfinite(corners)) or np.abs(corners).max() > LARGEST_LENGTH:
+        raise InputError(f"{name}: the part reaches {np.abs(corners).max():.3g} mm from the origin, beyond "
+                         f"{LARGEST_LENGTH:g} mm (10 km); parts are read in mm: check the file's unit")
+
+
+def closed_panels(topology: Topology, panels) -> None:
+    """InputError naming the first panel with no outline of its own: a closed surface (a sphere, a whole
+    closed shell grouped as one panel), which no single cut lays flat without gross distortion."""
+    for label, idx in panels:
+        members = set(idx)
+        touched = {e for k in idx for walk in topology.wires[k] for e, _ in walk if not topology.degenerate[e]}
+        if all(len(topology.edge_faces[e]) >= 2 and set(topology.edge_faces[e]) <= members for e in touched):
+            what = f"face {idx[0]}" if len(idx) == 1 else f"panel {label!r} (faces {', '.join(map(str, idx))})"
+            raise InputError(f"{topology.name}: {what} closes on itself (a closed surface, like a sphere, with no "
+                             f"outline): no single cut lays it flat without gross distortion; split it into "
+                             f"panels first (two domes, or gores: build123d split)")
+
+
 def panel_groups(topology: Topology, groups) -> tuple:
     """Panels as ``(name, face indices)``: the user's groups first (checked), then one per remaining face."""
     n = len(topology.faces)
@@ -130,6 +161,7 @@ def panel_groups(topology: Topology, groups) -> tuple:
             taken[i] = label
         panels.append((str(label), sorted(set(idx))))
     panels += [(f"face{i}", [i]) for i in range(n) if i not in taken]
+    closed_panels(topology, panels)
     return tuple(panels)
 
 
