@@ -303,6 +303,7 @@ def slow_folder(tmp_path_factory):
     v, f = surfaces.paraboloid_dish(n_faces=300_000)
     trimesh.Trimesh(v, f, process=False).export(parts / "slow.obj")
     shutil.copy(SAMPLES / "dish.obj", parts / "slow.stl.obj")  # and a name close to it
+    shutil.copy(SAMPLES / "cone.obj", parts / "cup.obj")  # a colliding pair: cup.step and cup.obj
     return parts
 
 
@@ -323,10 +324,10 @@ def test_batch_stops_a_file_at_its_timeout_and_finishes_the_others(slow_folder, 
     assert rows["slow.obj"].startswith("timeout: still running after 1 s: stopped")
     assert rows["broken.step"].startswith("failed: broken.step: not a readable STEP file")
     written = {p.name for p in (tmp_path / "out").iterdir()}
-    for name in ("cup", "dish", "cone", "hopper", "slow.stl"):
+    for name in ("cup.step", "cup.obj", "dish", "cone", "hopper", "slow.stl"):  # the pair both kept
         assert {f"{name}.dxf", f"{name}.json"} <= written
     assert not any(n.startswith("slow.dxf") or n.startswith(".~") for n in written)
-    assert "batch: 7 files: 5 ok, 1 failed, 1 timeout (2 processes); 5 written to" in proc.stdout
+    assert "batch: 8 files: 6 ok, 1 failed, 1 timeout (2 processes); 6 written to" in proc.stdout
 
 
 def _children(pid: int) -> list:
@@ -373,7 +374,7 @@ def test_a_stopped_batch_stops_its_workers_and_still_sums_up(slow_folder, tmp_pa
         proc.send_signal(sig)
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == code, out + err
-    assert f"batch: {word}: 7 files:" in err and "not run" in out
+    assert f"batch: {word}: 8 files:" in err and "not run" in out
     assert "Traceback" not in err
     time.sleep(0.5)
     assert not [w for w in workers if _alive_worker(w)]
