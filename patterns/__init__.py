@@ -40,7 +40,7 @@ from .flattening.sheetmetal import BendTable, UnfoldOptions, read_bend_table, un
 from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
 from .model import Bookkeeping, Model, Panel, Seam, Surface, SurfaceKind
-from .nesting import Layout, layout
+from .nesting import Layout, NestOptions, layout
 from .pattern import Dart, FlatPanel, FlatSeam, Pattern
 from .predicates import Overlap, overlap_verdict
 from .reading import LoadOptions, load, read_cad, read_mesh
@@ -84,6 +84,7 @@ __all__ = [
     "LoadOptions",
     "MeshTopologyError",
     "MeshingOptions",
+    "NestOptions",
     "Model",
     "Overlap",
     "Panel",

@@ -158,7 +158,7 @@ def _wanted(options: BatchOptions) -> tuple:
 # --------------------------------------------------------------------------- #
 
 
-def process_part(name: str, data: bytes, records: dict, wanted: tuple, roll_width: float | None = None) -> dict:
+def process_part(name: str, data: bytes, records: dict, wanted: tuple) -> dict:
     """Run the pipeline on one part given as bytes; return its row and outputs as bytes.  Never raises
     for the part's fault (a bad file, a limit, memory): that becomes the row's reason.
 
@@ -169,10 +169,9 @@ def process_part(name: str, data: bytes, records: dict, wanted: tuple, roll_widt
     data : bytes
         The file's content.
     records : dict
-        The option records (``"load"``, ``"flatten"``, ``"check"``, ``"dxf"``).
+        The option records (``"load"``, ``"flatten"``, ``"check"``, ``"dxf"``, and ``"nest"``).
     wanted : tuple of str
         Output kinds: ``"pattern"`` (DXF), ``"report"``, ``"heat_map"``, ``"preview"``.
-    roll_width : float, optional
 
     Returns
     -------
@@ -190,8 +189,7 @@ def process_part(name: str, data: bytes, records: dict, wanted: tuple, roll_widt
             source.write_bytes(data)
             outputs = {kind: Path(tmp) / _SUFFIXES[kind].format("out") for kind in wanted}
             try:
-                part = flatten_part(source, records, outputs=outputs, stage=lambda path, what: path,
-                                    roll_width=roll_width)
+                part = flatten_part(source, records, outputs=outputs, stage=lambda path, what: path)
             except PatternsError as exc:
                 row["reason"] = str(exc).replace(tmp + os.sep, "")
                 return row
@@ -289,8 +287,7 @@ def check_output_folder(out) -> None:
 
 
 def batch(files, out, *, records: dict | None = None, options: BatchOptions | None = None,
-          roll_width: float | None = None, on_row: Callable | None = None, on_start: Callable | None = None,
-          **keywords) -> BatchResult:
+          on_row: Callable | None = None, on_start: Callable | None = None, **keywords) -> BatchResult:
     """Flatten many parts in parallel into one folder: every file ends as a :class:`Row`.
 
     Parameters
@@ -304,12 +301,11 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
         name where two stems collide (``a.step.dxf``, ``a.stl.dxf``).
     records : dict, optional
         The part's option records (``"load"``, ``"flatten"``, ``"check"``,
-        ``"dxf"``), as the command line makes them; default from ``keywords``.
+        ``"dxf"``, ``"nest"``), as the command line makes them; default from
+        ``keywords``.
     options : BatchOptions, optional
         How the batch runs; keywords (``jobs``, ``scheduler``, ``timeout``,
         ``memory``, ``report``, ``preview``, ``heat_map``) go over it.
-    roll_width : float, optional
-        Nest each part's panels on a roll this wide (mm).
     on_row : callable, optional
         ``on_row(row, done, total)`` as each file ends (progress).
     on_start : callable, optional
@@ -317,7 +313,8 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
     **keywords
         Any option of ``flatten``: :class:`~patterns.LoadOptions`,
         :class:`~patterns.FlattenOptions`, :class:`~patterns.CheckOptions`,
-        :class:`~patterns.DxfOptions` fields, and :class:`BatchOptions` fields.
+        :class:`~patterns.DxfOptions`, :class:`~patterns.NestOptions` (each
+        part nested on its own roll or sheets) fields, and :class:`BatchOptions` fields.
 
     Returns
     -------
@@ -346,7 +343,7 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
     rows = {}
     stopped = ""
     try:
-        for index, row in runner.run(files, records, wanted, roll_width, on_start):
+        for index, row in runner.run(files, records, wanted, on_start):
             path = files[index]
             row = _commit(out, stems[path], row)
             rows[index] = row
@@ -368,9 +365,11 @@ def _options(options, records, keywords):
     from .audit import CheckOptions
     from .export.dxf import DxfOptions
     from .flattening import FlattenOptions
+    from .nesting import NestOptions
     from .reading import LoadOptions
 
-    kinds = {"load": LoadOptions, "flatten": FlattenOptions, "check": CheckOptions, "dxf": DxfOptions}
+    kinds = {"load": LoadOptions, "flatten": FlattenOptions, "check": CheckOptions, "dxf": DxfOptions,
+             "nest": NestOptions}
     mine = {k: v for k, v in keywords.items() if k in BatchOptions.__dataclass_fields__}
     rest = {k: v for k, v in keywords.items() if k not in mine}
     opts = BatchOptions.of(options, mine)
@@ -382,6 +381,10 @@ def _options(options, records, keywords):
         unknown = sorted(set(rest) - {f for r in kinds.values() for f in r.__dataclass_fields__})
         if unknown:
             raise InputError(f"unknown option {unknown[0]!r} for batch")
+        allowance = records["dxf"].seam_allowance  # a piece's room when nested: its largest seam allowance
+        margin = max(allowance.values(), default=0.0) if isinstance(allowance, dict) else allowance
+        if "margin" not in rest and margin:
+            records["nest"] = NestOptions.of(records["nest"], {"margin": margin})
     elif rest:
         raise InputError(f"give the part's options as records or as keywords, not both ({sorted(rest)[0]!r})")
     return opts, records
@@ -477,7 +480,7 @@ class _LocalRunner:
         if worker in self.workers:
             self.workers.remove(worker)
 
-    def run(self, files, records, wanted, roll_width, on_start):
+    def run(self, files, records, wanted, on_start):
         from multiprocessing.connection import wait
 
         pending = deque((i, 1) for i in range(len(files)))
@@ -499,7 +502,7 @@ class _LocalRunner:
                 if on_start is not None:
                     on_start(printable(path.name))
                 worker.task, worker.started = (index, tries), time.monotonic()
-                worker.conn.send((path.name, data, records, wanted, roll_width))
+                worker.conn.send((path.name, data, records, wanted))
             busy = [w for w in self.workers if w.task is not None]
             if not busy and not starting:
                 continue
@@ -581,7 +584,7 @@ class _DaskRunner:
         self.where = f"Dask scheduler {opts.scheduler}"
         self.client = None
 
-    def run(self, files, records, wanted, roll_width, on_start):
+    def run(self, files, records, wanted, on_start):
         try:
             from distributed import Client, as_completed
         except ImportError:
@@ -593,7 +596,7 @@ class _DaskRunner:
         futures = {}
         for index, path in enumerate(files):
             data = path.read_bytes()
-            future = self.client.submit(process_part, path.name, data, records, wanted, roll_width, pure=False,
+            future = self.client.submit(process_part, path.name, data, records, wanted, pure=False,
                                         retries=1)
             futures[future] = index
             if on_start is not None:

@@ -92,6 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     from .export.dxf import DxfOptions
     from .flattening import FlattenOptions
     from .flattening.sheetmetal import UnfoldOptions
+    from .nesting import NestOptions
     from .options import add_arguments
     from .reading import LoadOptions
 
@@ -121,8 +122,8 @@ def _parser() -> argparse.ArgumentParser:
     def output(p):
         group = p.add_argument_group("DXF output")
         add_arguments(group, DxfOptions, skip=("units",))  # --units: one flag with loading's
-        group.add_argument("--roll-width", type=float, default=None, metavar="MM",
-                           help="nest the panels on a roll this wide (mm) before writing; grain kept along the roll")
+        # the margin around each piece is the largest seam allowance
+        add_arguments(p.add_argument_group("nesting (sparrow)"), NestOptions, skip=("margin",))
 
     flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, or .obj for one panel)")
     flat.add_argument("-o", "--output", type=Path, required=True,
@@ -178,11 +179,12 @@ def _records(args, name=None):
         records["flatten"] = from_arguments(FlattenOptions, args, name=name)
         records["check"] = from_arguments(CheckOptions, args, name=name)
     if hasattr(args, "profile"):
-        records["dxf"] = from_arguments(DxfOptions, args, name=name)
-    if getattr(args, "roll_width", None) is not None:
-        from .options import check_number
+        from .nesting import NestOptions
 
-        args.roll_width = check_number(args.roll_width, "--roll-width (mm)", low=0, low_open=True, high=1e7)
+        records["dxf"] = from_arguments(DxfOptions, args, name=name)
+        allowance = records["dxf"].seam_allowance
+        margin = max(allowance.values(), default=0.0) if isinstance(allowance, dict) else allowance
+        records["nest"] = from_arguments(NestOptions, args, name=name, margin=margin)
     return records
 
 
@@ -270,8 +272,8 @@ def _run_part(args, outputs: dict, records: dict):
     progress = Progress("flattening")
     with Outputs(inputs=[args.input]) as out:
         try:
-            part = flatten_part(args.input, records, outputs=planned, stage=out.stage,
-                                roll_width=getattr(args, "roll_width", None), progress=progress, loaded=_loaded)
+            part = flatten_part(args.input, records, outputs=planned, stage=out.stage, progress=progress,
+                                loaded=_loaded)
         finally:
             progress.close()
         out.commit()
@@ -285,8 +287,7 @@ def _cmd_flatten(args) -> int:
     part = run.part
     print(f"flattened ({records['flatten'].method}) in {part.seconds['flatten']:.2f} s")
     if part.nest is not None:
-        print(f"nested on a {args.roll_width:g} mm roll: {part.nest.length:.1f} mm used, "
-              f"efficiency {part.nest.efficiency:.1%}")
+        print(f"nested on {part.nest} (sparrow, {part.nest.seconds:.1f} s)")
     _print_panels(part.report)
     _wrote(run, records)
     return _verdict(part.report)
@@ -390,8 +391,8 @@ def _cmd_batch(args) -> int:
     options = from_arguments(BatchOptions, args)
     files, _ = plan_batch(args.folder, args.output)
     progress = _BatchProgress(len(files), quiet=options.quiet)
-    result = batch(files, args.output, records=records, options=options, roll_width=args.roll_width,
-                   on_row=progress.row, on_start=progress.start)
+    result = batch(files, args.output, records=records, options=options, on_row=progress.row,
+                   on_start=progress.start)
     progress.close()
     table = [("file", "panels", "seams", "strain RMS %", "max %", "seconds", "status")]
     for r in result.rows:

@@ -125,8 +125,8 @@ class PartResult:
     preview_dpi: float | None = None
 
 
-def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, roll_width: float | None = None,
-                 progress=None, loaded: Callable | None = None) -> PartResult:
+def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, progress=None,
+                 loaded: Callable | None = None) -> PartResult:
     """Load, check the options against the part, flatten, nest, check, and write every output.
 
     Parameters
@@ -135,14 +135,13 @@ def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, roll_
         The part's file.
     records : dict
         The option records: ``"load"`` (LoadOptions), ``"flatten"``,
-        ``"check"``, and ``"dxf"`` when a pattern is written.
+        ``"check"``, ``"dxf"`` when a pattern is written, and ``"nest"``
+        (NestOptions: the pieces nested on a roll or sheets when it gives one).
     outputs : dict
         ``{kind: Path}`` as :func:`plan_outputs` returns it.
     stage : callable
         ``stage(path, what=...) -> Path``: where to write the output named
         ``path`` (a temporary file the caller renames when all are written).
-    roll_width : float, optional
-        Nest the panels on a roll this wide (mm) before writing.
     progress : callable, optional
         ``progress(done, total)`` while flattening.
     loaded : callable, optional
@@ -166,8 +165,8 @@ def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, roll_
     start = time.perf_counter()
     pattern = flatten(model, records["flatten"], progress=progress)
     nest = None
-    if roll_width is not None:
-        nest = pattern.layout(width=roll_width, margin=_margin(records["dxf"]))
+    if records.get("nest") is not None and records["nest"].active:
+        nest = pattern.layout(records["nest"])
         pattern = nest.pattern
     report = check(pattern, records["check"])
     seconds["flatten"] = time.perf_counter() - start
@@ -195,8 +194,3 @@ def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, roll_
     seconds["write"] = time.perf_counter() - start
     return PartResult(model, pattern, report, written, seconds, nest, dpi)
 
-
-def _margin(dxf) -> float:
-    """The largest seam allowance of the DXF options (the nesting margin), mm."""
-    allowance = dxf.seam_allowance
-    return max(allowance.values(), default=0.0) if isinstance(allowance, dict) else allowance

@@ -1,34 +1,144 @@
-"""Nesting: placing a pattern's panels on a roll (or sheet) of material.
+"""Nesting: a pattern's pieces placed on a roll or on sheets, by sparrow (``spyrrow``).
 
-:func:`layout` places every panel by its true outline, bottom-left first,
-largest panel first, with a gap between any two and the grain kept along the
-roll if asked; overlaps are checked with shapely at every trial.  The roll runs
-along +Y from y = 0, ``width`` wide (x from 0 to ``width``).
+:func:`layout` hands the true outlines (with the seam allowance) to sparrow, the
+state-of-the-art heuristic for irregular strip packing (J. Gardeyn and T.
+Wauters; ``spyrrow`` is its Python binding), with the gap as the least distance
+between two pieces and the grain as the orientations allowed; then checks the
+result with shapely on the placed outlines before anything uses it (no overlap,
+every gap kept, everything on the roll or sheet).
+
+The roll runs along +Y from y = 0, ``width`` wide (x from 0 to ``width``); a
+piece's +Y (its grain line) runs along the roll when the grain is kept.  Pieces
+may touch the roll's and the sheets' edges (give a narrower width to keep a
+border).  Sheets
+lie one after another along the roll's direction, :data:`SHEET_SPACING` apart in
+the drawing.
+
+What sparrow does not do, and so neither does this: it places no piece inside
+another's hole (an outline's holes are not offered as room), and it takes simple
+polygons only (each outline is simplified within 0.05 mm, outwards, so that the
+gap still holds on the true outline).  Its search runs for a time budget: the
+same input, seed and budget give the same marker on one machine; a faster
+machine may find a better one in the same time.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Protocol
+import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .errors import InputError, LayoutError
-from .options import check_number
+from .options import Options, option
 from .predicates import flat_polygon
 
-__all__ = ["Layout", "LayoutError", "Placeable", "layout"]
+__all__ = ["ROTATIONS", "SHEET_SPACING", "Layout", "LayoutError", "NestOptions", "Sheet", "layout"]
+
+ROTATIONS = ("grain", "quarter", "free", "none")
+"""How pieces may turn: ``grain`` 0 or 180 degrees (the grain stays along the roll), ``quarter``
+any multiple of 90, ``free`` any angle, ``none`` not at all."""
+
+_ANGLES = {"grain": [0.0, 180.0], "quarter": [0.0, 90.0, 180.0, 270.0], "free": None, "none": [0.0]}
+
+SHEET_SPACING = 100.0
+"""Between two sheets in the drawing, mm."""
+
+SIMPLIFY = 0.05
+"""Outlines are offered to sparrow simplified within this, mm (outwards: the gap holds on the true one)."""
 
 
-class Placeable(Protocol):
-    """What :func:`layout` needs of a pattern (:class:`patterns.Pattern` is one): its name, its flat
-    panels, and a copy with the panels placed.  A protocol rather than an import, because
-    ``Pattern.layout()`` calls this module."""
+def _sheet(value, option_name):
+    if value is None:
+        return None
+    try:
+        length, width = (float(x) for x in value)
+    except (TypeError, ValueError):
+        raise InputError(f"{option_name} must be (length, width) in mm, got {value!r}") from None
+    from .options import check_number
 
-    name: str
-    panels: tuple
+    return (check_number(length, f"{option_name} length (mm)", low=0, low_open=True, high=1e7),
+            check_number(width, f"{option_name} width (mm)", low=0, low_open=True, high=1e7))
 
-    def placed(self, placements) -> Placeable: ...
+
+def _parse_sheet(text: str):
+    """``"2500x1250"`` (command line) as ``(2500.0, 1250.0)``."""
+    parts = text.lower().replace("*", "x").split("x")
+    if len(parts) != 2:
+        raise ValueError(f"expected LENGTHxWIDTH in mm, e.g. 2500x1250, got {text!r}")
+    return tuple(float(p) for p in parts)
+
+
+def _quantities(value, option_name):
+    if value is None:
+        return None
+    try:
+        items = dict(value).items()
+    except (TypeError, ValueError):
+        raise InputError(f"{option_name} must map panel names to counts, e.g. {{'sleeve': 2}}") from None
+    from .options import check_number
+
+    return {str(k): check_number(n, f"{option_name}[{k!r}]", low=1, high=10000, integer=True) for k, n in items}
+
+
+def _parse_quantity(text: str):
+    name, sep, count = text.rpartition("=")
+    if not sep or not name:
+        raise ValueError(f"expected NAME=COUNT, got {text!r}")
+    return name, int(count)
+
+
+@dataclass(frozen=True, repr=False)
+class NestOptions(Options):
+    """Where and how the pieces are nested (:func:`layout`; ``--roll-width`` or ``--sheet`` on the command line)."""
+
+    width: float | None = option(None, "nest the pieces on a roll this wide, mm", low=0, low_open=True, optional=True,
+                                 unit="mm", flag="--roll-width")
+    sheet: tuple | None = option(None, "nest the pieces on sheets LENGTH x WIDTH mm, filled one after another "
+                                       "(command line: 2500x1250)", check=_sheet, parse=_parse_sheet,
+                                 optional=True, metavar="LxW")
+    gap: float = option(10.0, "least distance between two pieces, mm", low=0, unit="mm", flag="--nest-gap")
+    margin: float = option(0.0, "room kept around each outline, mm (the seam allowance; the command line "
+                                "takes the largest --seam-allowance)", low=0, high=1000, unit="mm")
+    rotations: str = option("grain", "how pieces may turn: grain (0 or 180 degrees: the grain along the roll), "
+                                     "quarter (multiples of 90), free, none", choices=ROTATIONS)
+    copies: int = option(1, "pieces of every panel (a pattern cut this many times)", integer=True, low=1,
+                         high=10000, metavar="N")
+    mirror: bool = option(False, "each piece also as its mirror image (left and right)")
+    quantities: dict | None = option(None, "pieces of named panels, over copies (API: {'sleeve': 2}; command "
+                                           "line NAME=N, repeatable)", check=_quantities, parse=_parse_quantity,
+                                     repeat=True, flag="--quantity", metavar="NAME=N")
+    time_limit: int = option(10, "seconds the nester searches (sparrow); longer may save a little material",
+                             integer=True, low=1, high=86400, flag="--nest-time", metavar="S")
+    seed: int = option(0, "the search's seed (the same input, seed and time give the same marker on one machine)",
+                       integer=True, low=0, high=2**32 - 1, flag="--nest-seed", metavar="N")
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.width is not None and self.sheet is not None:
+            raise InputError("nest on a roll (width) or on sheets (sheet), not both")
+
+    @property
+    def active(self) -> bool:
+        """True when a roll or a sheet is given (else nothing is nested)."""
+        return self.width is not None or self.sheet is not None
+
+
+@dataclass(frozen=True)
+class Sheet:
+    """One sheet of a nest on sheets: its pieces and how much of it they use."""
+
+    index: int
+    pieces: tuple
+    """The names of the pieces on it."""
+    area_pieces: float
+    """mm^2."""
+    area: float
+    """The sheet's area, mm^2."""
+
+    @property
+    def usage(self) -> float:
+        return self.area_pieces / self.area if self.area > 0 else 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -38,59 +148,59 @@ class Layout:
     Attributes
     ----------
     pattern : patterns.Pattern
-        The pattern laid out (``pattern.laid_out`` is True; each panel's
-        ``placement`` says where it is).
+        The pattern laid out, copies included (``pattern.laid_out`` is True;
+        each panel's ``placement`` says where it is; ``pattern.stock`` the roll
+        or sheets, drawn in the DXF).
     width : float
-        The roll's width, mm.
+        The roll's (or sheets') width, mm.
     length : float
-        Roll length used: the top of the highest panel, mm.
+        Roll length used (the end of the furthest piece), or the sheets' total length, mm.
     area_used : float
-        ``width * length``, mm^2.
+        ``width * length``, mm^2 (a nest on sheets: the sheets' area).
     area_panels : float
-        The panels' flat area, mm^2.
+        The pieces' cut area (with the margin), mm^2.
+    sheets : tuple of Sheet
+        Sheet by sheet, for a nest on sheets; empty on a roll.
+    seconds : float
+        The search's time.
     """
 
-    pattern: Placeable
+    pattern: object
     width: float
     length: float
     area_used: float
     area_panels: float
+    sheets: tuple = ()
+    seconds: float = 0.0
+    options: NestOptions = field(default_factory=NestOptions)
 
     @property
     def efficiency(self) -> float:
-        """Share of the used material that ends up in panels (0..1)."""
+        """Share of the used material that ends up in pieces (0..1)."""
         return self.area_panels / self.area_used if self.area_used > 0 else 0.0
 
+    def __str__(self) -> str:
+        if self.sheets:
+            return (f"{len(self.sheets)} sheet{'s' if len(self.sheets) != 1 else ''} of {self.options.sheet[0]:g} x "
+                    f"{self.width:g} mm, usage "
+                    + ", ".join(f"{s.usage:.1%}" for s in self.sheets) + f" ({self.efficiency:.1%} in all)")
+        return f"a {self.width:g} mm roll: {self.length:.1f} mm used, efficiency {self.efficiency:.1%}"
 
-def _orientations(allow_rotation: bool, respect_grain: bool) -> list[float]:
-    if respect_grain:
-        return [0.0, np.pi] if allow_rotation else [0.0]  # the grain stays along the roll
-    return [0.0, 0.5 * np.pi, np.pi, 1.5 * np.pi] if allow_rotation else [0.0]
 
-
-def layout(pattern, *, width: float, gap: float = 10.0, margin: float = 0.0, allow_rotation: bool = True,
-           respect_grain: bool = True, step: float | None = None) -> Layout:
-    """Nest the panels of a pattern on a roll ``width`` mm wide.
+def layout(pattern, options: NestOptions | None = None, **keywords) -> Layout:
+    """Nest a pattern's pieces on a roll or on sheets (sparrow), checked with shapely.
 
     Parameters
     ----------
     pattern : patterns.Pattern
-    width : float
-        Roll (or sheet) width, mm.
-    gap : float
-        Clearance between panels and from the roll's edges... between panels
-        only: panels may touch the roll's edges.  mm, >= 0.
-    margin : float
-        Extra room around each panel's outline, mm (a seam allowance to be added
-        when the DXF is written).
-    allow_rotation : bool
-        Turn panels by multiples of 90 degrees (180 only, when
-        ``respect_grain``).
-    respect_grain : bool
-        Keep every panel's +Y (its grain line, see ``flatten(grain=...)``)
-        along the roll.
-    step : float, optional
-        Horizontal positions tried, mm apart (default: width / 150).
+    options : NestOptions, optional
+        The options as a record; keywords go over it: ``width`` (a roll, mm)
+        or ``sheet`` (``(length, width)`` mm), ``gap`` (least distance between
+        pieces, default 10 mm), ``margin`` (room around each outline: the seam
+        allowance), ``rotations`` (``"grain"``: 0 or 180 degrees, the default;
+        ``"quarter"``, ``"free"``, ``"none"``), ``copies``, ``mirror``,
+        ``quantities`` (``{panel name: count}``), ``time_limit`` (seconds,
+        default 10), ``seed``.
 
     Returns
     -------
@@ -99,87 +209,198 @@ def layout(pattern, *, width: float, gap: float = 10.0, margin: float = 0.0, all
     Raises
     ------
     InputError
-        Bad options.
+        Bad options, or no roll and no sheet.
     LayoutError
-        A panel is wider than the roll in every allowed orientation.
+        A piece that fits the roll or sheet in no allowed orientation, or a
+        result that fails the shapely check (never returned).
     """
+    if not (hasattr(pattern, "panels") and callable(getattr(pattern, "with_copies", None))):
+        raise InputError(f"layout() takes a patterns.Pattern, got {type(pattern).__name__}")
+    opts = NestOptions.of(options, keywords, name=pattern.name)
+    if not opts.active:
+        raise InputError(f"{pattern.name}: give a roll width or a sheet to nest on")
+    names = [flat.name for flat in pattern.panels]
+    counts = [opts.copies] * len(names)
+    for name, n in (opts.quantities or {}).items():
+        if name not in names:
+            raise InputError(f"{pattern.name}: quantities name panel {name!r}; the panels are {', '.join(names)}")
+        counts[names.index(name)] = n
+    pieces = pattern.with_copies(counts, mirror=opts.mirror)
+    shapes = [_outline(flat, opts.margin) for flat in pieces.panels]
+    across = opts.width if opts.width is not None else opts.sheet[1]
+    along = None if opts.sheet is None else opts.sheet[0]
+    for flat, shape in zip(pieces.panels, shapes):
+        _check_fits(pattern.name, flat.name, shape, across, along, opts.rotations)
+    start = time.perf_counter()
+    if opts.sheet is None:
+        placements = _solve(shapes, list(range(len(shapes))), across, opts)
+        sheets, stock = (), [(0.0, 0.0, across, None)]
+    else:
+        placements, sheets, stock = _fill_sheets(shapes, pieces, opts)
+    seconds = time.perf_counter() - start
+    laid = pieces.placed([placements[i] for i in range(len(shapes))])
+    placed = [_outline(flat, opts.margin) for flat in laid.panels]
+    _verify(pattern.name, laid, placed, across, opts, stock)
+    area_pieces = float(sum(p.area for p in placed))
+    if sheets:
+        length = opts.sheet[0] * len(sheets)
+        used = opts.sheet[0] * opts.sheet[1] * len(sheets)
+        rects = tuple(stock)
+    else:
+        length = max(float(np.max(np.asarray(p.exterior.coords)[:, 1])) for p in placed)
+        used = across * length
+        rects = ((0.0, 0.0, across, length),)
+    result = Layout(None, float(across), float(length), float(used), area_pieces, tuple(sheets), seconds, opts)
+    from dataclasses import replace
+
+    laid = replace(laid, stock=rects, stock_note=str(result))
+    return replace(result, pattern=laid)
+
+
+def _outline(flat, margin: float):
+    """The piece's cut outline as placed (holes not offered as room), grown by the margin."""
+    outline = flat_polygon(flat.uv, flat.loops, holes=False)
+    return outline.buffer(margin, join_style="mitre") if margin else outline
+
+
+def _item_points(shape) -> np.ndarray:
+    """The outline offered to sparrow: grown and simplified within SIMPLIFY, in its frame (x along the
+    strip = the piece's +Y, y across = its -X)."""
     import shapely
+
+    simple = shapely.simplify(shape.buffer(SIMPLIFY, join_style="mitre"), SIMPLIFY)
+    if simple.geom_type != "Polygon":
+        simple = max(getattr(simple, "geoms", [simple]), key=lambda g: g.area)
+    pts = np.asarray(simple.exterior.coords)[:-1]
+    return np.column_stack([pts[:, 1], -pts[:, 0]])
+
+
+def _extent_across(shape, rotations: str) -> tuple[float, float]:
+    """The least width the piece takes across the strip, and its length along it then, over the turns allowed."""
     from shapely import affinity
 
-    # What a Pattern is, by what layout uses of it (importing the class would make a cycle:
-    # Pattern.layout() calls this function).
-    if not (hasattr(pattern, "panels") and callable(getattr(pattern, "placed", None))):
-        raise InputError(f"layout() takes a patterns.Pattern, got {type(pattern).__name__}")
-    width = check_number(width, "width (mm)", low=0, low_open=True, name=pattern.name)
-    gap = check_number(gap, "gap (mm)", low=0, name=pattern.name)
-    margin = check_number(margin, "margin (mm)", low=0, name=pattern.name)
-    step = width / 150.0 if step is None else check_number(step, "step (mm)", low=0, low_open=True,
-                                                           name=pattern.name)
-    shapes, outlines, base = [], [], []
-    for flat in pattern.panels:
-        uv = flat.flattening.uv
-        outline = flat_polygon(uv, flat.loops, holes=False)
-        turn = 0.0
-        if not respect_grain:
-            # Square the panel up first: its minimum rotated rectangle along the axes.
-            box = np.asarray(shapely.minimum_rotated_rectangle(outline).exterior.coords)
-            edge = box[1] - box[0]
-            turn = -float(np.arctan2(edge[1], edge[0]))
-        base.append(turn)
-        outline = affinity.rotate(outline, turn, origin=(0.0, 0.0), use_radians=True)
-        outlines.append(outline.buffer(margin, join_style="mitre") if margin else outline)
-        # For the collision tests: half the gap around each (simplified within 0.25 mm,
-        # so the buffer is 0.25 mm wider to stay clear).
-        shapes.append(shapely.simplify(outline.buffer(margin + 0.5 * gap + 0.25, join_style="mitre"), 0.25))
-    order = np.argsort([-s.area for s in shapes], kind="stable")
-    placed = []  # placed (buffered) shapes
-    placements = [None] * len(shapes)
-    top = 0.0
-    for i in order:
-        best = None
-        for angle in _orientations(allow_rotation, respect_grain):
-            turned = affinity.rotate(shapes[i], angle, origin=(0.0, 0.0), use_radians=True)
-            x0, y0, x1, y1 = affinity.rotate(outlines[i], angle, origin=(0.0, 0.0), use_radians=True).bounds
-            w, h = x1 - x0, y1 - y0
-            if w > width + 1e-9:
-                continue
-            union = shapely.union_all(placed) if placed else None
-            if union is not None:
-                shapely.prepare(union)
-            for x in np.append(np.arange(0.0, width - w, step), width - w):
-                dx = x - x0
+    angles = _ANGLES[rotations]
+    angles = np.arange(0.0, 180.0, 1.0) if angles is None else angles
+    best = None
+    for a in angles:
+        x0, y0, x1, y1 = affinity.rotate(shape, a, origin=(0, 0)).bounds
+        if best is None or (x1 - x0) < best[0]:
+            best = (x1 - x0, y1 - y0)
+    return best
 
-                def free(y, dx=dx):
-                    if union is None:
-                        return True
-                    return not union.intersects(affinity.translate(turned, dx, y - y0))
 
-                lo, hi = 0.0, top + gap + 1.0
-                if free(lo):
-                    y = lo
-                else:
-                    for _ in range(30):
-                        mid = 0.5 * (lo + hi)
-                        if free(mid):
-                            hi = mid
-                        else:
-                            lo = mid
-                    y = hi
-                key = (y + h, x)
-                if best is None or key < best[0]:
-                    best = (key, angle, dx, y - y0, turned)
-        if best is None:
-            raise LayoutError(f"{pattern.name}: panel {pattern.panels[i].name} is wider than the "
-                              f"{width:g} mm roll in every allowed orientation")
-        _, angle, dx, dy, turned = best
-        shape = affinity.translate(turned, dx, dy)
-        placed.append(shape)
-        top = max(top, best[0][0])
-        placements[i] = (angle + base[i], dx, dy)
-    laid = pattern.placed(placements)
-    # Length used: the top of the highest outline (without the half gap).
-    length = max(float(np.max(flat.uv[:, 1])) for flat in laid.panels)
-    low = min(float(np.min(flat.uv[:, 1])) for flat in laid.panels)
-    length = length - min(low, 0.0)
-    area_panels = float(sum(flat.area for flat in laid.panels))
-    return Layout(laid, float(width), length, float(width) * length, area_panels)
+def _check_fits(name, piece, shape, across, along, rotations):
+    width, length = _extent_across(shape, rotations)
+    if width > across + 1e-9:
+        what = f"{across:g} mm roll" if along is None else f"{along:g} x {across:g} mm sheet"
+        raise LayoutError(f"{name}: piece {piece} is {width:.1f} mm wide, wider than the {what} in every allowed "
+                          f"orientation (rotations={rotations!r})")
+    if along is not None and not _fits_sheet(shape, across, along, rotations):
+        raise LayoutError(f"{name}: piece {piece} does not fit on a {along:g} x {across:g} mm sheet in any allowed "
+                          f"orientation (rotations={rotations!r})")
+
+
+def _fits_sheet(shape, across, along, rotations) -> bool:
+    from shapely import affinity
+
+    angles = _ANGLES[rotations]
+    for a in (np.arange(0.0, 180.0, 1.0) if angles is None else angles):
+        x0, y0, x1, y1 = affinity.rotate(shape, a, origin=(0, 0)).bounds
+        if x1 - x0 <= across + 1e-9 and y1 - y0 <= along + 1e-9:
+            return True
+    return False
+
+
+def _solve(shapes, which, across, opts) -> dict:
+    """Sparrow on the pieces ``which``: ``{piece: (angle rad, dx, dy)}`` on a roll ``across`` wide."""
+    import spyrrow
+
+    items = []
+    for k, i in enumerate(which):
+        pts = _item_points(shapes[i])
+        items.append(spyrrow.Item(str(k), [tuple(map(float, p)) for p in pts], demand=1,
+                                  allowed_orientations=_ANGLES[opts.rotations]))
+    # sparrow keeps every item the separation away from the strip's edges too: a strip two gaps wider,
+    # and everything moved back by a gap, lets pieces touch the roll's edges (as a cutter may).
+    edge = float(opts.gap)
+    instance = spyrrow.StripPackingInstance("patterns", strip_height=float(across) + 2 * edge, items=items)
+    config = spyrrow.StripPackingConfig(early_termination=True, total_computation_time=int(opts.time_limit),
+                                        min_items_separation=float(opts.gap) if opts.gap > 0 else None,
+                                        seed=int(opts.seed), num_workers=1)
+    solution = instance.solve(config)
+    out = {}
+    for placed in solution.placed_items:
+        i = which[int(placed.id)]
+        theta = np.radians(placed.rotation) % (2 * np.pi)  # in [0, 2 pi): sparrow says -180 for 180
+        tx, ty = placed.translation
+        # sparrow's frame (x along, y across) is the piece's turned by -90 degrees; ours is sparrow's
+        # turned back by +90 and moved across by the roll's width: a turn of theta, then a move.
+        out[i] = (float(theta), float(across + edge - ty), float(tx - edge))
+    return out
+
+
+def _ends(shapes, found) -> dict:
+    """How far along the strip each placed piece reaches, mm."""
+    from shapely import affinity
+
+    return {i: affinity.translate(affinity.rotate(shapes[i], angle, origin=(0, 0), use_radians=True), dx, dy).bounds[3]
+            for i, (angle, dx, dy) in found.items()}
+
+
+def _fill_sheets(shapes, pieces, opts):
+    """Sheet after sheet: the pieces nested on a strip as wide as a sheet, those lying wholly within the
+    sheet's length kept on it; then each piece left over, largest first, tried on that sheet too (a short
+    search of the sheet's pieces and it, kept if all fit), until the sheet's time is spent; the rest go on
+    to the next sheet."""
+    from dataclasses import replace
+
+    length, width = opts.sheet
+    left = list(range(len(shapes)))
+    placements, sheets, stock = {}, [], []
+    trial = replace(opts, time_limit=max(1, opts.time_limit // 5))
+    while left:
+        start = time.monotonic()
+        found = _solve(shapes, left, width, opts)
+        ends = _ends(shapes, found)
+        on_sheet = [i for i in left if ends[i] <= length + 1e-9]
+        if not on_sheet:  # the nearest piece alone, from the start of the sheet
+            i = min(left, key=lambda j: found[j][2])
+            angle, dx, dy = found[i]
+            found = _solve(shapes, [i], width, trial)
+            on_sheet = [i]
+        found = {i: found[i] for i in on_sheet}
+        for i in sorted((j for j in left if j not in on_sheet), key=lambda j: -shapes[j].area):
+            if time.monotonic() - start > 2 * opts.time_limit:
+                break
+            attempt = _solve(shapes, on_sheet + [i], width, trial)
+            if max(_ends(shapes, attempt).values()) <= length + 1e-9:
+                on_sheet.append(i)
+                found = attempt
+        offset = len(sheets) * (length + SHEET_SPACING)
+        for i in on_sheet:
+            angle, dx, dy = found[i]
+            placements[i] = (angle, dx, dy + offset)
+        area = float(sum(shapes[i].area for i in on_sheet))
+        sheets.append(Sheet(len(sheets), tuple(pieces.panels[i].name for i in on_sheet), area, length * width))
+        stock.append((0.0, offset, width, offset + length))
+        left = [i for i in left if i not in on_sheet]
+    return placements, sheets, stock
+
+
+def _verify(name, laid, placed, across, opts, stock) -> None:
+    """Raise LayoutError unless every gap holds, no two pieces overlap, and all lie on the stock."""
+    import shapely
+
+    tol = 1e-6 * max(across, 1.0)
+    tree = shapely.STRtree(placed)
+    left, right = tree.query(placed, predicate="dwithin", distance=max(opts.gap - tol, 0.0))
+    for a, b in zip(left, right):
+        if a < b and (opts.gap > 0 or placed[a].intersection(placed[b]).area > tol):
+            d = placed[a].distance(placed[b])
+            raise LayoutError(f"{name}: pieces {laid.panels[a].name} and {laid.panels[b].name} lie {d:.3f} mm "
+                              f"apart, under the {opts.gap:g} mm gap (the nest is refused, not written)")
+    rects = [shapely.box(x0, y0, x1, y1 if y1 is not None else 1e12) for x0, y0, x1, y1 in stock]
+    room = shapely.union_all(rects).buffer(tol)
+    for flat, shape in zip(laid.panels, placed):
+        if not room.contains(shape):
+            raise LayoutError(f"{name}: piece {flat.name} lies off the roll or sheet (the nest is refused)")

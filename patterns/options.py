@@ -326,10 +326,14 @@ def from_arguments(record: type, args, *, name: str | None = None, **extra):
         spec = f.metadata.get("spec")
         if spec is None or f.name in extra:
             continue
+        dest = _dest("--no-" + f.name.replace("_", "-")) if isinstance(f.default, bool) and f.default \
+            and not spec.flag else _dest(flag_of(f.name, spec))
+        if not hasattr(args, dest):
+            continue  # a field the parser has no flag for (skipped by add_arguments): its default
         if isinstance(f.default, bool) and f.default and not spec.flag:
-            values[f.name] = not getattr(args, _dest("--no-" + f.name.replace("_", "-")))
+            values[f.name] = not getattr(args, dest)
         else:
-            value = getattr(args, _dest(flag_of(f.name, spec)))
+            value = getattr(args, dest)
             if not (spec.repeat and value is None):
                 values[f.name] = value
     values.update(extra)

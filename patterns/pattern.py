@@ -142,11 +142,41 @@ class FlatPanel:
     panel: Panel
     flattening: Flattening
     placement: tuple = (0.0, 0.0, 0.0)
-    darts: tuple = ()
-    """The :class:`Dart` s cut by ``flatten(..., max_strain=...)``."""
     """``(angle, dx, dy)``: the rigid motion (radians, mm) that puts the
     flattened panel where it lies on the sheet: rotate about the origin, then
     move.  ``(0, 0, 0)`` until the pattern is laid out."""
+    darts: tuple = ()
+    """The :class:`Dart` s cut by ``flatten(..., max_strain=...)``."""
+    source: int | None = None
+    """For a copy (:meth:`Pattern.with_copies`): the index of the panel it copies, whose seams and
+    notches it shares; None for the panel itself."""
+    mirrored: bool = False
+    """A mirror image of its source (the left piece of a left and right pair): 3D panel and flat
+    piece reflected across their first axis, faces and loops turned so that both stay
+    counter-clockwise."""
+
+    def copy(self, name: str, *, source: int, mirrored: bool = False) -> FlatPanel:
+        """Another piece of this panel, named ``name`` (a mirror image if ``mirrored``)."""
+        if not mirrored:
+            return replace(self, name=name, source=source, mirrored=self.mirrored)
+        fl, panel = self.flattening, self.panel
+        flip3, flip2 = np.array([-1.0, 1.0, 1.0]), np.array([-1.0, 1.0])
+        faces = np.ascontiguousarray(fl.faces[:, ::-1])
+        loops = tuple(np.ascontiguousarray(loop[::-1]) for loop in fl.loops)
+        uv = fl.uv * flip2
+        uv.setflags(write=False)
+        from .predicates import overlap_verdict
+
+        flattening = replace(fl, uv=uv, vertices=fl.vertices * flip3, faces=faces, loops=loops,
+                             overlap=overlap_verdict(uv, faces, loops))
+        surface = panel.surface
+        if surface is not None:
+            surface = replace(surface, origin=surface.origin * flip3, x_dir=surface.x_dir * flip3,
+                              y_dir=surface.y_dir * flip3, axis=surface.axis * flip3,
+                              directrix=None if surface.directrix is None else surface.directrix * flip3)
+        mirror = replace(panel, vertices=panel.vertices * flip3, faces=panel.faces[:, ::-1],
+                         loops=tuple(loop[::-1] for loop in panel.loops), surface=surface)
+        return FlatPanel(name, mirror, flattening, self.placement, self.darts, source, not self.mirrored)
 
     @property
     def uv(self) -> np.ndarray:
@@ -366,6 +396,11 @@ class Pattern:
     """True once the panels have been placed on a sheet (:meth:`placed`): only
     then are panels checked against each other."""
     max_strain: float | None = None
+    stock: tuple = ()
+    """Once nested (:func:`patterns.layout`): the roll or each sheet as ``(x0, y0, x1, y1)`` mm, drawn
+    in the DXF on layer STOCK."""
+    stock_note: str = ""
+    """Once nested: what the nest used ("a 1500 mm roll: 3592.0 mm used, efficiency 74.2 %")."""
 
     @property
     def name(self) -> str:
@@ -404,23 +439,71 @@ class Pattern:
 
         write_pattern_dxf(self, path, options, **keywords)
 
-    def layout(self, *, width: float, **options):
-        """Nest the panels on a roll ``width`` mm wide; the options (``gap``,
-        ``margin``, ``allow_rotation``, ``respect_grain``, ``step``) and their
-        defaults are those of :func:`patterns.nesting.layout`.
+    def layout(self, options=None, **keywords):
+        """Nest the pieces on a roll (``width=``) or on sheets (``sheet=(length, width)``); the options
+        and their defaults are those of :func:`patterns.layout` (:class:`patterns.NestOptions`).
 
-        Returns a :class:`patterns.nesting.Layout`: ``.pattern`` (laid out),
-        ``.length`` used, ``.efficiency``.
+        Returns a :class:`patterns.nesting.Layout`: ``.pattern`` (laid out,
+        copies included), ``.length`` used, ``.efficiency``, ``.sheets``.
         """
         from .nesting import layout
 
-        return layout(self, width=width, **options)
+        return layout(self, options, **keywords)
 
     def heat_map(self, path, **options) -> None:
         """Write the strain heat map (PNG or SVG); see :func:`patterns.heat_map`."""
         from .export.heatmap import heat_map
 
         heat_map(self, path, **options)
+
+    @classmethod
+    def combined(cls, patterns) -> Pattern:
+        """Several patterns as one, to nest together (a marker of many parts): panels named
+        ``"<pattern>/<panel>"``, seams renumbered, each pattern's own seams kept between its own panels."""
+        patterns = list(patterns)
+        if not patterns or not all(isinstance(p, Pattern) for p in patterns):
+            raise InputError("combined() takes one or more patterns.Pattern")
+        if any(p.laid_out for p in patterns):
+            raise InputError("combined() takes patterns that are not laid out yet")
+        panels, seams, flats, flat_seams = [], [], [], []
+        for p in patterns:
+            offset, sid = len(panels), len(seams)
+            for flat in p.panels:
+                if flat.source is not None:
+                    raise InputError(f"{p.name}: combine the patterns before making copies")
+                panels.append(replace(flat.panel, name=f"{p.name}/{flat.panel.name}"))
+                flats.append(replace(flat, name=f"{p.name}/{flat.name}", panel=panels[-1]))
+            for fs in p.seams:
+                seam = replace(fs.seam, id=sid + fs.seam.id, panels=tuple(offset + k for k in fs.seam.panels))
+                seams.append(seam)
+                flat_seams.append(replace(fs, seam=seam))
+        model = Model(name=" + ".join(p.name for p in patterns), panels=tuple(panels), seams=tuple(seams),
+                      max_edge=max(p.model.max_edge for p in patterns))
+        first = patterns[0]
+        return replace(first, model=model, panels=tuple(flats), seams=tuple(flat_seams),
+                       method="+".join(dict.fromkeys(p.method for p in patterns)))
+
+    def source_of(self, index: int) -> int:
+        """The panel whose seams panel ``index`` shares: itself, or the panel it is a copy of."""
+        source = self.panels[index].source
+        return index if source is None else source
+
+    def with_copies(self, counts, *, mirror: bool = False) -> Pattern:
+        """The pattern with ``counts[i]`` pieces of panel ``i`` (and, with ``mirror``, as many mirror
+        images besides): the copies come after the panels, named ``face0 #2``, ``face0 mirrored``, ...,
+        each sharing its source's seams, notches and labels."""
+        counts = [int(c) for c in counts]
+        if len(counts) != len(self.panels) or min(counts, default=1) < 1:
+            raise InputError(f"{self.name}: one count >= 1 per panel, got {counts!r}")
+        extra = []
+        for i, (flat, n) in enumerate(zip(self.panels, counts)):
+            for k in range(1, n):
+                extra.append(flat.copy(f"{flat.name} #{k + 1}", source=i))
+            if mirror:
+                for k in range(n):
+                    label = f"{flat.name} mirrored" if k == 0 else f"{flat.name} #{k + 1} mirrored"
+                    extra.append(flat.copy(label, source=i, mirrored=True))
+        return replace(self, panels=self.panels + tuple(extra))
 
     def placed(self, placements) -> Pattern:
         """A copy with the panels moved rigidly: one ``(angle, dx, dy)`` per panel.

@@ -278,14 +278,15 @@ def test_sheet_metal_options(tmp_path):
 def test_garment_options(tmp_path):
     out = tmp_path / "cup.dxf"
     proc = run("flatten", SAMPLES / "cup.step", "-o", out, "--grain", "0,0,1", "--notch-spacing", "20",
-               "--seam-allowance", "10", "--roll-width", "600")
+               "--seam-allowance", "10", "--roll-width", "600", "--nest-time", "2")
     assert proc.returncode == 0, proc.stderr
     assert "nested on a 600 mm roll" in proc.stdout
     doc, auditor = recover.readfile(out)
     assert not auditor.has_errors
     assert len(doc.modelspace().query('LINE[layer=="NOTCH"]')) == 4 * 2 * 8
     cuts = [shapely.Polygon([p[:2] for p in e.get_points("xy")]) for e in doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')]
-    assert max(c.bounds[2] for c in cuts) <= 600 + 1e-6 and min(c.bounds[0] for c in cuts) >= -1e-6
+    margin = patterns.export.dxf.MARGIN  # the drawing starts this far from the axes
+    assert max(c.bounds[2] for c in cuts) <= 600 + margin + 1e-6 and min(c.bounds[0] for c in cuts) >= margin - 1e-6
     bad = run("flatten", SAMPLES / "cup.step", "-o", tmp_path / "x.dxf", "--grain", "1,2")
     assert bad.returncode == 2 and "X,Y,Z" in bad.stderr
 

@@ -1,12 +1,16 @@
-"""patterns.nesting: panels on a roll, checked with shapely on the placed outlines."""
+"""patterns.nesting: pieces on a roll or on sheets by sparrow, checked with shapely on the placed outlines."""
 
 import build123d as bd
+import ezdxf
 import numpy as np
 import pytest
 import shapely
 
 import patterns
-from patterns.errors import LayoutError
+from patterns.errors import InputError, LayoutError
+from patterns.nesting import NestOptions
+
+QUICK = {"time_limit": 1}  # sparrow's search, seconds: enough for these few pieces
 
 
 @pytest.fixture(scope="module")
@@ -19,31 +23,37 @@ def _outlines(pattern):
     return [shapely.Polygon(flat.uv[flat.loops[0]]) for flat in pattern.panels]
 
 
+def _min_distance(polys):
+    return min(polys[i].distance(polys[j]) for i in range(len(polys)) for j in range(i + 1, len(polys)))
+
+
 @pytest.mark.parametrize(("width", "gap"), [(450.0, 10.0), (230.0, 5.0)])
-def test_placed_panels_keep_the_gap_and_the_roll(plates, width, gap):
-    nest = plates.layout(width=width, gap=gap)
+def test_placed_pieces_keep_the_gap_and_the_roll(plates, width, gap):
+    nest = plates.layout(width=width, gap=gap, **QUICK)
     polys = _outlines(nest.pattern)
-    for i in range(len(polys)):
-        for j in range(i + 1, len(polys)):
-            assert polys[i].distance(polys[j]) >= gap - 1e-6
+    assert _min_distance(polys) >= gap - 1e-6
     x = np.concatenate([np.asarray(p.exterior.coords)[:, 0] for p in polys])
     y = np.concatenate([np.asarray(p.exterior.coords)[:, 1] for p in polys])
-    assert x.min() >= -1e-6 and x.max() <= width + 1e-6
-    assert nest.length == pytest.approx(y.max() - min(0.0, y.min()), abs=1e-6)
+    assert x.min() >= -1e-6 and x.max() <= width + 1e-6 and y.min() >= -1e-6
+    assert nest.length == pytest.approx(y.max(), abs=1e-6)
     area = sum(p.area for p in polys)
     assert area == pytest.approx(2 * (200 * 100 + 200 * 50 + 100 * 50), rel=1e-9)  # nothing rescaled
     assert nest.efficiency == pytest.approx(area / (width * nest.length), rel=1e-9)
     assert patterns.check(nest.pattern).ok  # the report's own overlap test agrees
 
 
-def test_a_panel_wider_than_the_roll_is_refused(plates):
-    with pytest.raises(LayoutError, match="wider than"):
-        plates.layout(width=40.0, allow_rotation=False)
+def test_four_equal_rectangles_pack_two_by_two():
+    """Four 100 x 50 rectangles, grain along the roll, on a 211 mm roll with a 10 mm gap: two fit side
+    by side, so the shortest marker is two rows, 50 + 10 + 50 = 110 mm long (sparrow sees each outline
+    0.05 mm larger: at most 110.2 mm); three rows would be 170 mm."""
+    nest = _rectangles([(100.0, 50.0)] * 4).layout(width=211.0, gap=10.0, **QUICK)
+    assert 110.0 <= nest.length <= 110.2 + 1e-6
+    assert nest.efficiency == pytest.approx(4 * 100 * 50 / (211.0 * nest.length), rel=1e-9)
 
 
 def test_the_grain_stays_along_the_roll(plates):
-    """respect_grain: panels turn by 0 or 180 degrees only."""
-    nest = plates.layout(width=450.0, respect_grain=True)
+    """rotations="grain" (the default): every piece turned by 0 or 180 degrees only."""
+    nest = plates.layout(width=450.0, **QUICK)
     for flat in nest.pattern.panels:
         angle = flat.placement[0] % np.pi
         assert min(angle, np.pi - angle) < 1e-9
@@ -66,101 +76,132 @@ def _rectangles(sizes, name="rects"):
                             grain=(0, 1, 0))
 
 
-def test_four_equal_rectangles_pack_two_by_two():
-    """Four 100 x 50 rectangles on a 211 mm roll with a 10 mm gap: two fit side by side, so the
-    shortest marker is two rows, 50 + 10 + 50 = 110 mm long.  The nester keeps 0.5 mm more than
-    the gap (its collision shapes are simplified within 0.25 mm and widened by as much), so two
-    rows take at most 110.5 mm, and three rows (171 mm) would mean a worse search."""
-    pattern = _rectangles([(100.0, 50.0)] * 4)
-    nest = pattern.layout(width=211.0, gap=10.0, allow_rotation=False, step=1.0)
-    assert 110.0 <= nest.length <= 110.5 + 1e-6
-    assert nest.efficiency == pytest.approx(4 * 100 * 50 / (211.0 * nest.length), rel=1e-9)
-
-
-def test_a_long_panel_is_turned_across_only_when_the_grain_may_turn():
-    """A 300 x 40 panel on a 100 mm roll fits only turned by 90 degrees: allowed without the
-    grain, refused with it (the grain must stay along the roll) or without rotation."""
+def test_a_long_piece_is_turned_across_only_when_it_may_turn():
+    """A 300 x 40 piece on a 100 mm roll fits only turned by 90 degrees: done with quarter or free
+    turns, refused with the grain kept (0 or 180 only) or with no turn at all."""
     pattern = _rectangles([(300.0, 40.0)])
-    nest = pattern.layout(width=100.0, respect_grain=False)
-    (flat,) = nest.pattern.panels
-    turned = flat.placement[0] % np.pi
-    assert abs(turned - np.pi / 2) < 1e-9
-    assert np.ptp(flat.uv[:, 0]) == pytest.approx(40.0, abs=1e-6) and nest.length == pytest.approx(300.0, abs=1e-6)
-    for kwargs in ({"respect_grain": True}, {"respect_grain": False, "allow_rotation": False}):
-        with pytest.raises(LayoutError, match="wider than the 100 mm roll"):
-            pattern.layout(width=100.0, **kwargs)
+    for rotations in ("quarter", "free"):
+        nest = pattern.layout(width=100.0, rotations=rotations, **QUICK)
+        (flat,) = nest.pattern.panels
+        assert np.ptp(flat.uv[:, 0]) == pytest.approx(40.0, abs=0.1)  # across the roll
+        assert nest.length == pytest.approx(300.0, abs=0.2)
+    for rotations in ("grain", "none"):
+        with pytest.raises(LayoutError, match="wider than the 100 mm roll in every allowed orientation"):
+            pattern.layout(width=100.0, rotations=rotations, **QUICK)
 
 
 def test_the_margin_is_kept_around_each_outline():
-    """A margin (a seam allowance added later) keeps the outlines gap + 2 x margin apart."""
-    nest = _rectangles([(100.0, 50.0)] * 3).layout(width=400.0, gap=10.0, margin=5.0)
+    """A margin (the seam allowance the DXF adds) keeps the outlines gap + 2 x margin apart and the
+    margin inside the roll."""
+    nest = _rectangles([(100.0, 50.0)] * 3).layout(width=400.0, gap=10.0, margin=5.0, **QUICK)
     polys = _outlines(nest.pattern)
-    assert min(polys[i].distance(polys[j]) for i in range(3) for j in range(i + 1, 3)) >= 20.0 - 1e-6
+    assert _min_distance(polys) >= 20.0 - 1e-6
     x = np.concatenate([np.asarray(p.exterior.coords)[:, 0] for p in polys])
-    assert x.min() >= 5.0 - 1e-6 and x.max() <= 400.0 - 5.0 + 1e-6  # the margin inside the roll too
+    assert x.min() >= 5.0 - 1e-6 and x.max() <= 400.0 - 5.0 + 1e-6
 
 
-@pytest.mark.parametrize(("kwargs", "words"), [({"width": 0.0}, "width"), ({"width": 100.0, "gap": -1.0}, "gap"),
-                                               ({"width": 100.0, "margin": -1.0}, "margin"),
-                                               ({"width": 100.0, "step": 0.0}, "step")])
-def test_bad_layout_options(plates, kwargs, words):
+@pytest.mark.parametrize(("kwargs", "words"), [
+    ({"width": 0.0}, "width must be a positive number"), ({"width": 100.0, "gap": -1.0}, "gap must be"),
+    ({"width": 100.0, "margin": -1.0}, "margin must be"), ({"width": 100.0, "rotations": "some"}, "rotations must"),
+    ({"width": 100.0, "sheet": (100, 100)}, "a roll \\(width\\) or on sheets \\(sheet\\), not both"),
+    ({"sheet": (100, -1)}, "sheet width \\(mm\\) must be"), ({}, "give a roll width or a sheet"),
+    ({"width": 100.0, "copies": 0}, "copies must be"), ({"width": 100.0, "quantities": {"nope": 2}},
+                                                         "quantities name panel 'nope'"),
+    ({"width": 100.0, "time_limit": 0}, "time_limit must be")])
+def test_bad_nest_options(plates, kwargs, words):
     """One line naming the pattern and the option."""
-    from patterns.errors import InputError
-
-    with pytest.raises(InputError, match=rf"^{plates.name}: {words} \(mm\) must"):
+    with pytest.raises(InputError, match=rf"^{plates.name}: .*{words}"):
         plates.layout(**kwargs)
 
 
-def test_small_numbers_are_options_not_errors(plates):
-    """Sub-millimetre widths and gaps are numbers like any other: a 0.5 mm roll is too narrow
-    for the panels (a LayoutError), a 0.5 mm gap is kept."""
-    from patterns.errors import InputError
-
-    with pytest.raises(LayoutError, match="wider than"):
-        plates.layout(width=0.5)
-    nest = plates.layout(width=450.0, gap=0.5)
-    polys = _outlines(nest.pattern)
-    assert min(polys[i].distance(polys[j]) for i in range(len(polys)) for j in range(i + 1, len(polys))) >= 0.5 - 1e-6
+def test_only_a_pattern_is_nested():
     with pytest.raises(InputError, match="layout\\(\\) takes a patterns.Pattern"):
         patterns.layout(type("Almost", (), {"panels": (), "name": "x"})(), width=100.0)
 
 
-def test_the_orientations_tried():
-    from patterns.nesting import _orientations
-
-    assert _orientations(True, True) == [0.0, np.pi]  # grain kept: turned end for end at most
-    assert _orientations(False, True) == [0.0] and _orientations(False, False) == [0.0]
-    assert _orientations(True, False) == [0.0, 0.5 * np.pi, np.pi, 1.5 * np.pi]
-
-
-def test_the_defaults_are_those_documented(plates):
-    """gap 10 mm, no margin, rotation allowed, grain kept: the same marker as asked for in full."""
-    default = patterns.layout(plates, width=450.0)  # the function's own defaults
-    explicit = plates.layout(width=450.0, gap=10.0, margin=0.0, allow_rotation=True, respect_grain=True)
-    assert [f.placement for f in default.pattern.panels] == [f.placement for f in explicit.pattern.panels]
-    assert default.width == 450.0 and default.length == explicit.length
-    for other in ({"gap": 11.0}, {"margin": 1.0}, {"respect_grain": False}):
-        changed = plates.layout(width=450.0, **other)
-        assert [f.placement for f in changed.pattern.panels] != [f.placement for f in default.pattern.panels]
+def test_the_same_seed_gives_the_same_marker(plates):
+    a = plates.layout(width=300.0, rotations="quarter", **QUICK)
+    b = plates.layout(width=300.0, rotations="quarter", **QUICK)
+    assert [f.placement for f in a.pattern.panels] == [f.placement for f in b.pattern.panels]
+    assert a.length == b.length
 
 
-def test_a_panel_laid_askew_is_squared_up_and_placed_where_its_outline_is():
-    """Without the grain, a rectangle drawn at 30 degrees is turned square to the roll first: the
-    placed outline, read from the placed panel, is axis-aligned, inside the roll, and the length is
-    its top."""
-    from patterns.reading import mesh_model
+def test_copies_and_mirrored_pairs(tmp_path):
+    """Two of every piece and each also mirrored: four pieces per panel, the mirrored ones the reflected
+    outline (same area, turned the other way), all carrying their source's seams in the DXF (notches at
+    both ends of every seam side on every piece)."""
+    from .conftest import SAMPLES
 
-    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
-    x, y = np.meshgrid(np.linspace(0, 120, 7), np.linspace(0, 40, 3))
-    pts = np.column_stack([x.ravel(), y.ravel()]) @ np.array([[c, s], [-s, c]])
-    quads = [(r * 7 + k, r * 7 + k + 1, (r + 1) * 7 + k + 1, (r + 1) * 7 + k) for r in range(2) for k in range(6)]
-    tri = np.array([t for a, b, cc, d in quads for t in ((a, b, cc), (a, cc, d))])
-    pattern = patterns.flatten(mesh_model(np.column_stack([pts, np.zeros(len(pts))]), tri, name="askew"),
-                               method="isometric")
-    nest = pattern.layout(width=200.0, respect_grain=False, allow_rotation=False)
-    (poly,) = _outlines(nest.pattern)
-    x0, y0, x1, y1 = poly.bounds
-    assert poly.area == pytest.approx(120 * 40, rel=1e-9)
-    assert (x1 - x0) * (y1 - y0) == pytest.approx(120 * 40, rel=1e-6)  # squared up: its box is itself
-    assert x0 >= -1e-6 and x1 <= 200.0 + 1e-6 and y0 >= -1e-6
-    assert nest.length == pytest.approx(y1, abs=1e-6) and nest.width == 200.0
+    cup = patterns.flatten(patterns.load(SAMPLES / "cup.step"))
+    nest = cup.layout(width=900.0, copies=2, mirror=True, **QUICK)
+    laid = nest.pattern
+    assert len(laid.panels) == 16
+    names = [f.name for f in laid.panels]
+    assert {"face0", "face0 #2", "face0 mirrored", "face0 #2 mirrored"} <= set(names)
+    for flat in laid.panels:
+        source = cup.panels[laid.source_of(laid.panels.index(flat))]
+        assert flat.area == pytest.approx(source.area, rel=1e-9)  # nothing rescaled
+        # a mirror image: the same edge lengths, read along its loop the other way round
+        a = np.linalg.norm(np.diff(source.outline(), axis=0, append=source.outline()[:1]), axis=1)
+        b = np.linalg.norm(np.diff(flat.outline(), axis=0, append=flat.outline()[:1]), axis=1)
+        assert sorted(np.round(a, 6)) == sorted(np.round(b, 6))
+    assert patterns.check(laid).ok
+    path = tmp_path / "marker.dxf"
+    laid.to_dxf(path, seam_allowance=10.0)
+    doc = ezdxf.readfile(path)
+    assert len(doc.modelspace().query('LINE[layer=="NOTCH"]')) == 16 * 2 * 2  # 2 seams x 2 ends per piece
+    (stock,) = doc.modelspace().query('LWPOLYLINE[layer=="STOCK"]')
+    assert np.ptp(np.array(stock.get_points("xy"))[:, 0]) == pytest.approx(900.0)
+    texts = [t.dxf.text for t in doc.modelspace().query("TEXT")]
+    assert any(f"efficiency {nest.efficiency:.1%}" in t for t in texts)
+
+
+def test_quantities_per_panel(plates):
+    name = plates.panels[0].name
+    nest = plates.layout(width=450.0, quantities={name: 3}, **QUICK)
+    assert [f.name for f in nest.pattern.panels].count(name) == 1
+    assert sum(f.name.startswith(f"{name} #") for f in nest.pattern.panels) == 2
+    assert len(nest.pattern.panels) == len(plates.panels) + 2
+
+
+def test_sheets_are_filled_one_after_another(plates):
+    """Twelve rectangles on 400 x 300 mm sheets: every piece wholly on one sheet, sheets reported one by
+    one with the area of their own pieces (shapely's) over the sheet's."""
+    nest = plates.layout(sheet=(400.0, 300.0), copies=2, **QUICK)
+    polys = _outlines(nest.pattern)
+    assert _min_distance(polys) >= 10.0 - 1e-6
+    assert sum(len(s.pieces) for s in nest.sheets) == 12
+    total = 0.0
+    for sheet, (x0, y0, x1, y1) in zip(nest.sheets, nest.pattern.stock):
+        assert (x1 - x0, y1 - y0) == (300.0, 400.0)  # the sheet's width across, its length along
+        mine = [p for f, p in zip(nest.pattern.panels, polys) if f.name in sheet.pieces]
+        box = shapely.box(x0, y0, x1, y1)
+        assert all(box.buffer(1e-6).contains(p) for p in mine)
+        assert sheet.usage == pytest.approx(sum(p.area for p in mine) / (400.0 * 300.0), rel=1e-9)
+        total += sum(p.area for p in mine)
+    assert nest.efficiency == pytest.approx(total / (len(nest.sheets) * 400.0 * 300.0), rel=1e-9)
+    assert total == pytest.approx(4 * (200 * 100 + 200 * 50 + 100 * 50), rel=1e-9)
+
+
+def test_a_piece_too_big_for_the_sheet_is_refused(plates):
+    with pytest.raises(LayoutError, match="does not fit on a 150 x 300 mm sheet"):
+        plates.layout(sheet=(150.0, 300.0), rotations="none", **QUICK)
+
+
+def test_a_nest_that_breaks_the_gap_is_refused_not_returned(plates):
+    """The shapely check itself: two pieces 1 mm apart under a 10 mm gap are refused."""
+    from patterns.nesting import _outline, _verify
+
+    first = _outline(plates.panels[0], 0.0)
+    x1 = first.bounds[2]
+    laid = plates.placed([(0.0, 0.0, 0.0), (0.0, x1 + 1.0 - plates.panels[1].uv[:, 0].min(), 0.0)]
+                         + [(0.0, 1000.0 + 400.0 * k, 0.0) for k in range(4)])
+    placed = [_outline(f, 0.0) for f in laid.panels]
+    with pytest.raises(LayoutError, match="under the 10 mm gap"):
+        _verify("plates", laid, placed, 5000.0, NestOptions(width=5000.0), [(0.0, -1000.0, 5000.0, None)])
+
+
+def test_the_options_record_is_the_keywords(plates):
+    a = plates.layout(NestOptions(width=450.0, time_limit=1))
+    b = plates.layout(width=450.0, time_limit=1)
+    assert [f.placement for f in a.pattern.panels] == [f.placement for f in b.pattern.panels]

@@ -158,6 +158,7 @@ MACHINE_LAYERS = {
     "DRILL": 4,  # cyan: drill holes (POINT), at dart tips
     "LABEL": 7,  # white/black: every text
     "STRAIN": 8,  # grey: optional strain heat map (filled triangles)
+    "STOCK": 9,  # light grey: the roll's edges or the sheets, once nested (never cut)
 }
 """Layers of the machine profile and their colours (AutoCAD colour index)."""
 
@@ -204,12 +205,14 @@ class _PanelGeometry:
 
 
 def _segment_seams(pattern, index) -> dict:
-    """``(vertex a, vertex b) -> seam id`` for the boundary segments of panel ``index`` on a seam."""
+    """``(vertex a, vertex b) -> seam id`` for the boundary segments of panel ``index`` on a seam
+    (a copy's are its source's)."""
     out = {}
+    source = pattern.source_of(index)
     for fs in pattern.seams:
         seam = fs.seam
         for p, idx in zip(seam.panels, seam.vertices):
-            if p == index:
+            if p == source:
                 for a, b in zip(idx[:-1], idx[1:]):
                     out[(int(a), int(b))] = seam.id
     return out
@@ -340,11 +343,12 @@ def _seam_annotations(pattern, geo, unit: Unit = Unit.MM):
     """``(text, [(place (2,), tangent (2,)), ...])`` for every seam side on the panel: the places its
     label may go, along the seam (its middle first), 1.6 label heights inside the panel."""
     flat = pattern.panels[geo.index]
+    source = pattern.source_of(geo.index)
     out = []
     for fs in pattern.seams:
         seam = fs.seam
         for side, (p, idx) in enumerate(zip(seam.panels, seam.vertices)):
-            if p != geo.index:
+            if p != source:
                 continue
             pts = geo.uv[idx]
             if _runs_along_loop(flat.loops, idx) < 0:
@@ -416,12 +420,13 @@ def _notches(pattern, geo, allowance_of, spacing=None):
     along an edge).
     """
     flat = pattern.panels[geo.index]
+    source = pattern.source_of(geo.index)
     cut = shapely.Polygon(geo.cut_loops[0], geo.cut_loops[1:])
     out = []
     for fs in pattern.seams:
         seam = fs.seam
         for side, p in enumerate(seam.panels):
-            if p != geo.index:
+            if p != source:
                 continue
             along = _runs_along_loop(flat.loops, seam.vertices[side])
             depth = allowance_of(seam.id)
@@ -645,8 +650,9 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
     if not r12:
         doc.header["$INSUNITS"] = unit.insunits
     doc.header["$MEASUREMENT"] = unit.measurement
+    stock = getattr(pattern, "stock", ())
     for name, color in MACHINE_LAYERS.items():
-        if name != "STRAIN" or strain_layer:
+        if (name != "STRAIN" or strain_layer) and (name != "STOCK" or stock):
             doc.layers.add(name, color=color)
     msp = doc.modelspace()
 
@@ -699,6 +705,12 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
             text(label.text, label.at, label.height, label.angle, layer=layer)
         if strain_layer:
             _strain_solids(msp, pattern.panels[g.index], g.uv, scale, truecolor=version not in ("R12", "R2000"))
+    for x0, y0, x1, y1 in stock:  # the roll's edges, or each sheet: a nest's marker
+        poly(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), "STOCK")
+    if stock and pattern.stock_note:
+        x0, y0, x1, _ = stock[0]
+        th = max(g.text_height for g in geos)
+        text(f"{pattern.name}: {pattern.stock_note}", ((x0 + x1) / 2, y0 - 2 * th), th)
     if r12:  # above the whole drawing, clear of every piece
         top = max(float(np.max(loop[:, 1])) for g in geos for loop in g.cut_loops)
         left = min(float(np.min(loop[:, 0])) for g in geos for loop in g.cut_loops)

@@ -1,0 +1,112 @@
+"""Nesting on sparrow against the previous nester, side by side on the same pieces (issue 22).
+
+The marker of the issue: four pieces of every panel of the cup, duct and hopper samples (36
+pieces) on a 1500 mm roll with a 10 mm gap, turned by multiples of 90 degrees; then the same with
+the grain kept along the roll (0 or 180 degrees); then the same 36 on 2500 x 1250 mm sheets.
+The previous nester (bottom-left, largest first, shapely collision tests; removed by issue 22) is
+read from git at the commit given (``--old``, default 5138836, the last commit that had it) and run
+on the same pieces; each marker is checked with shapely (every gap kept, nothing off the roll).
+
+    python benchmarks/nesting.py [--old COMMIT] [--budget S ...] [--no-old]
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import time
+import types
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+import patterns
+from patterns.pattern import Pattern
+
+REPO = Path(__file__).resolve().parent.parent
+SAMPLES = REPO / "samples"
+
+
+def pieces():
+    return Pattern.combined([patterns.flatten(patterns.load(SAMPLES / f"{n}.step"))
+                             for n in ("cup", "duct_transition", "hopper")])
+
+
+def old_nester(commit: str):
+    """The bottom-left nester as it was at ``commit``, as a module."""
+    text = subprocess.run(["git", "show", f"{commit}:patterns/nesting.py"], cwd=REPO, capture_output=True, text=True,
+                          check=True).stdout
+    text = text.replace("from .errors", "from patterns.errors").replace("from .options", "from patterns.options") \
+        .replace("from .predicates", "from patterns.predicates")
+    module = types.ModuleType("old_nesting")
+    sys.modules["old_nesting"] = module  # dataclasses look their module up
+    exec(compile(text, f"{commit}:patterns/nesting.py", "exec"), module.__dict__)  # noqa: S102 - our own history
+    return module
+
+
+def checked_gap(pattern, gap: float, width: float) -> float:
+    """The least distance between two placed outlines, after checking every piece lies on the roll."""
+    polys = [shapely.Polygon(f.uv[f.loops[0]]) for f in pattern.panels]
+    x = np.concatenate([np.asarray(p.exterior.coords)[:, 0] for p in polys])
+    assert x.min() >= -1e-6 and x.max() <= width + 1e-6
+    tree = shapely.STRtree(polys)
+    a, b = tree.query(polys, predicate="dwithin", distance=gap * 2)
+    d = min((polys[i].distance(polys[j]) for i, j in zip(a, b) if i < j), default=float("inf"))
+    assert d >= gap - 1e-6, d
+    return d
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--old", default="5138836", help="the commit whose bottom-left nester to run beside")
+    parser.add_argument("--budget", type=int, nargs="+", default=[10, 30], help="sparrow's time budgets, s")
+    parser.add_argument("--no-old", action="store_true", help="leave the previous nester out (it takes a minute)")
+    args = parser.parse_args(argv)
+    base = pieces()
+    four = base.with_copies([4] * len(base.panels))
+    print(f"36 pieces ({len(base.panels)} panels x 4), area {sum(f.area for f in four.panels) / 1e6:.3f} m^2; "
+          f"roll 1500 mm, gap 10 mm\n")
+    print("| nester | turns | budget s | roll used mm | efficiency | seconds | least gap mm | rerun |")
+    print("|---|---|---|---|---|---|---|---|")
+    rows = {}
+    if not args.no_old:
+        old = old_nester(args.old)
+        for turns, grain in (("quarter", False), ("grain", True)):
+            start = time.perf_counter()
+            nest = old.layout(four, width=1500.0, gap=10.0, allow_rotation=True, respect_grain=grain)
+            seconds = time.perf_counter() - start
+            gap = checked_gap(nest.pattern, 10.0, 1500.0)
+            rows[("old", turns)] = (nest.length, seconds)
+            print(f"| bottom-left ({args.old}) | {turns} | - | {nest.length:.1f} | {nest.efficiency:.3f} | "
+                  f"{seconds:.1f} | {gap:.2f} | - |", flush=True)
+    for turns in ("quarter", "grain"):
+        for budget in args.budget:
+            runs = []
+            for _ in range(2):
+                start = time.perf_counter()
+                nest = base.layout(width=1500.0, gap=10.0, copies=4, rotations=turns, time_limit=budget)
+                runs.append((nest, time.perf_counter() - start))
+            nest, seconds = runs[0]
+            gap = checked_gap(nest.pattern, 10.0, 1500.0)
+            same = "same" if runs[1][0].length == nest.length else f"{runs[1][0].length:.1f}"
+            old = rows.get(("old", turns))
+            vs = f" ({nest.length / old[0] - 1:+.1%} length, {seconds / old[1]:.2f}x time)" if old else ""
+            print(f"| sparrow{vs} | {turns} | {budget} | {nest.length:.1f} | {nest.efficiency:.3f} | {seconds:.1f} | "
+                  f"{gap:.2f} | {same} |", flush=True)
+    print("\nsheets 2500 x 1250 mm, the same 36 pieces, turned by multiples of 90 degrees:\n")
+    print("| budget s | sheets | usage, sheet by sheet | in all | seconds |")
+    print("|---|---|---|---|---|")
+    for budget in args.budget[:1]:
+        start = time.perf_counter()
+        nest = base.layout(sheet=(2500.0, 1250.0), gap=10.0, copies=4, rotations="quarter", time_limit=budget)
+        seconds = time.perf_counter() - start
+        print(f"| {budget} | {len(nest.sheets)} | " + ", ".join(f"{s.usage:.1%} ({len(s.pieces)} pieces)"
+                                                          for s in nest.sheets)
+              + f" | {nest.efficiency:.1%} | {seconds:.1f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
