@@ -51,6 +51,8 @@ class BatchOptions(Options):
     scheduler: str | None = option(None, "run on a Dask distributed cluster at this address (tcp://host:8786) "
                                          "instead of local processes; needs patterns[dask] here and patterns on "
                                          "every worker, no shared disk", optional=True, metavar="ADDRESS")
+    wait: float = option(30.0, "Dask: seconds to wait for a first worker to join the scheduler", low=0,
+                         low_open=True, high=86400, metavar="S")
     timeout: float = option(600.0, "seconds one file may take; a file still running then is stopped and reported "
                                    "(its worker replaced)", low=0, low_open=True, high=1e6, metavar="S")
     memory: float | None = option(None, "megabytes of memory (address space) one local worker process may use, "
@@ -239,8 +241,14 @@ def _worker_main(conn, budget: int | None, one_thread: bool) -> None:  # pragma:
             if task is None:
                 return
             conn.send(process_part(*task))
+    except MemoryError:  # even the file's bytes do not fit the budget: the parent says so
+        os._exit(_OUT_OF_MEMORY)
     except BaseException:  # noqa: BLE001 - the parent sees the pipe close: the file is retried or lost
         os._exit(1)
+
+
+_OUT_OF_MEMORY = 3
+"""A local worker's exit code when a file's bytes alone exceed its memory budget."""
 
 
 def _die_with_parent() -> None:
@@ -340,6 +348,8 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
     out = Path(out)
     wanted = _wanted(opts)
     runner = _DaskRunner(opts) if opts.scheduler else _LocalRunner(opts, len(files))
+    if opts.scheduler:
+        runner.connect()  # the address, the workers and their patterns checked before any work
     rows = {}
     stopped = ""
     try:
@@ -483,7 +493,10 @@ class _LocalRunner:
     def run(self, files, records, wanted, on_start):
         from multiprocessing.connection import wait
 
-        pending = deque((i, 1) for i in range(len(files)))
+        # The largest files first (the longest work first balances the processes best); rows still come
+        # back in whatever order they end, and the batch reports them in the files' order.
+        sizes = [files[i].stat().st_size if files[i].exists() else 0 for i in range(len(files))]
+        pending = deque((i, 1) for i in sorted(range(len(files)), key=lambda i: -sizes[i]))
         for _ in range(self.n):
             self._start()
         while pending or any(w.task for w in self.workers):
@@ -502,7 +515,10 @@ class _LocalRunner:
                 if on_start is not None:
                     on_start(printable(path.name))
                 worker.task, worker.started = (index, tries), time.monotonic()
-                worker.conn.send((path.name, data, records, wanted))
+                try:
+                    worker.conn.send((path.name, data, records, wanted))
+                except OSError:  # it died as the file was handed over: the answer's wait below sees it
+                    pass
             busy = [w for w in self.workers if w.task is not None]
             if not busy and not starting:
                 continue
@@ -534,7 +550,11 @@ class _LocalRunner:
                     code = worker.process.exitcode
                     self._stop(worker)
                     self._start()
-                    if tries < 2:
+                    if code == _OUT_OF_MEMORY:  # no retry: the budget is the same on the next worker
+                        yield index, {"file": files[index].name, "status": "failed",
+                                      "reason": "out of memory (over the worker's memory budget)",
+                                      "seconds": time.monotonic() - worker.started}
+                    elif tries < 2:
                         pending.appendleft((index, tries + 1))  # its worker died: once more, on a new one
                     else:
                         yield index, {"file": files[index].name, "status": "lost",
@@ -577,41 +597,160 @@ def _total_memory() -> float | None:
 
 
 class _DaskRunner:
-    """The same tasks (bytes in, bytes out) on a Dask distributed cluster."""
+    """The same tasks (bytes in, bytes out) on a Dask distributed cluster, checked before the first task.
+
+    Before any work: the address parsed (``tcp://host:port``, or ``host:port``), the port reached
+    (3 s; a port that answers HTTP is the dashboard's, and is named so), the client connected, at
+    least one worker waited for, and ``patterns`` -- its version -- found on every worker and on the
+    scheduler (workers without it, or with another version, are named).  Then every file goes as
+    bytes (scattered when large), results come back as bytes and are released as they arrive.  A
+    file still running after ``timeout`` is reported and its future cancelled (Dask cannot stop a
+    task that runs: its worker goes on until it ends); one whose worker died is retried once by
+    the client, then reported lost.
+    """
+
+    CONNECT = 3.0
+    """Seconds to reach the scheduler's port, and to connect."""
 
     def __init__(self, opts: BatchOptions):
         self.opts = opts
         self.where = f"Dask scheduler {opts.scheduler}"
         self.client = None
 
-    def run(self, files, records, wanted, on_start):
+    def connect(self) -> None:
         try:
-            from distributed import Client, as_completed
+            from distributed import Client
         except ImportError:
             raise InputError("--scheduler needs Dask: pip install 'patterns[dask]'") from None
+        address = _scheduler_address(self.opts.scheduler, self.CONNECT)
         try:
-            self.client = Client(self.opts.scheduler, timeout="20s")
+            self.client = Client(address, timeout=f"{self.CONNECT}s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"{self.opts.scheduler}: cannot reach the Dask scheduler ({exc})") from None
-        futures = {}
-        for index, path in enumerate(files):
+        try:
+            self.client.wait_for_workers(1, timeout=self.opts.wait)
+        except (TimeoutError, OSError):
+            self.close()
+            raise InputError(f"{self.opts.scheduler}: no Dask worker joined the scheduler within "
+                             f"{self.opts.wait:g} s (start one: dask worker {address})") from None
+        self._check_versions()
+
+    def _check_versions(self) -> None:
+        from . import __version__ as mine
+
+        # A builtin, so that it unpickles anywhere: the version of the patterns that imports there.
+        probe = (eval, "__import__('patterns').__version__")
+        found = self.client.run(*probe, on_error="return")
+        lacking = sorted(w for w, v in found.items() if isinstance(v, ImportError))
+        other = sorted(f"{w} ({v})" for w, v in found.items() if not isinstance(v, BaseException) and v != mine)
+        broken = sorted(w for w, v in found.items() if isinstance(v, BaseException) and w not in lacking)
+        try:  # the scheduler unpickles the tasks: it needs patterns too
+            on_scheduler = self.client.run_on_scheduler(*probe)
+        except ImportError:
+            on_scheduler = None
+        except Exception:  # noqa: BLE001 - a scheduler that refuses to run code: its workers decide
+            on_scheduler = mine
+        problems = []
+        if lacking or broken:
+            problems.append(f"workers without patterns: {', '.join(lacking + broken)} (pip install patterns there)")
+        if other:
+            problems.append(f"workers with another patterns than this machine's {mine}: {', '.join(other)}")
+        if on_scheduler is None:
+            problems.append("the scheduler has no patterns (pip install patterns there too)")
+        elif on_scheduler != mine:
+            problems.append(f"the scheduler has patterns {on_scheduler}, this machine {mine}")
+        if problems:
+            self.close()
+            raise InputError(f"{self.opts.scheduler}: " + "; ".join(problems))
+
+    def run(self, files, records, wanted, on_start):
+        from distributed import wait
+
+        pending = {}  # future -> (index, tries)
+        seen_running = {}  # future key -> when first seen processing
+
+        def submit(index, tries):
+            path = files[index]
             data = path.read_bytes()
-            future = self.client.submit(process_part, path.name, data, records, wanted, pure=False,
-                                        retries=1)
-            futures[future] = index
-            if on_start is not None:
+            payload = self.client.scatter(data, hash=False) if len(data) > 1 << 20 else data
+            future = self.client.submit(process_part, path.name, payload, records, wanted, pure=False)
+            pending[future] = (index, tries)
+            if on_start is not None and tries == 1:
                 on_start(printable(path.name))
-        for future in as_completed(futures):
-            index = futures.pop(future)
-            try:
-                row = future.result()
-            except Exception as exc:  # noqa: BLE001 - KilledWorker, a worker without patterns, ...
-                row = {"file": files[index].name, "status": "lost",
-                       "reason": f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"}
-            future.release()
-            yield index, row
+
+        for index in range(len(files)):
+            submit(index, 1)
+        while pending:
+            with contextlib.suppress(Exception):  # none finished in that second, or one was lost: see below
+                wait(list(pending), timeout=1.0, return_when="FIRST_COMPLETED")
+            done = [f for f in pending if f.done()]
+            for future in done:
+                index, tries = pending.pop(future)
+                try:
+                    row = future.result()
+                except Exception as exc:  # noqa: BLE001 - KilledWorker, a lost connection, ...
+                    if tries < 2:
+                        submit(index, tries + 1)  # its worker died: once more
+                        future.release()
+                        continue
+                    row = {"file": files[index].name, "status": "lost",
+                           "reason": f"its worker died twice ({type(exc).__name__}: killed -- out of memory, or a "
+                                     f"crash)"}
+                future.release()
+                yield index, row
+            running = {key for keys in self.client.processing().values() for key in keys}
+            now = time.monotonic()
+            for future in list(pending):
+                if future.key in running:
+                    started = seen_running.setdefault(future.key, now)
+                    if now - started > self.opts.timeout:
+                        index, _ = pending.pop(future)
+                        future.cancel()
+                        yield index, {"file": files[index].name, "status": "timeout",
+                                      "reason": f"still running after {self.opts.timeout:g} s: given up (Dask "
+                                                f"cannot stop a running task; its worker ends it)",
+                                      "seconds": now - started}
 
     def close(self) -> None:
         if self.client is not None:
             with contextlib.suppress(Exception):
                 self.client.close()
+            self.client = None
+
+
+def _scheduler_address(text: str, timeout: float) -> str:
+    """``tcp://host:port``, checked: parsed, the port reached, and not the dashboard's (InputError otherwise)."""
+    import socket
+
+    raw = text.strip()
+    scheme, sep, rest = raw.partition("://")
+    if not sep:
+        scheme, rest = "tcp", raw
+    if scheme in ("http", "https"):
+        raise InputError(f"{text}: a web address: the Dask dashboard's? give the scheduler's, tcp://HOST:8786")
+    if scheme != "tcp":
+        raise InputError(f"{text}: the scheduler's address is tcp://HOST:PORT, not {scheme}://")
+    host, sep, port = rest.rstrip("/").rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise InputError(f"{text}: expected tcp://HOST:PORT (the scheduler's port, usually 8786)")
+    host = host.strip("[]")
+    try:
+        sock = socket.create_connection((host, int(port)), timeout=timeout)
+    except socket.gaierror:
+        raise InputError(f"{text}: unknown host {host!r}") from None
+    except TimeoutError:
+        raise InputError(f"{text}: cannot reach the Dask scheduler (no answer in {timeout:g} s)") from None
+    except OSError as exc:
+        raise InputError(f"{text}: cannot reach the Dask scheduler ({exc.strerror or exc})") from None
+    try:  # a scheduler says nothing to this; a web server (the dashboard, on 8787) answers HTTP
+        sock.settimeout(1.0)
+        sock.sendall(b"GET / HTTP/1.0\r\n\r\n")
+        answer = sock.recv(5)
+    except OSError:
+        answer = b""
+    finally:
+        sock.close()
+    if answer.startswith(b"HTTP"):
+        raise InputError(f"{text}: that port answers HTTP: it is the Dask dashboard, not the scheduler (give the "
+                         f"scheduler's port, usually 8786)")
+    return f"tcp://{host}:{port}" if ":" not in host else f"tcp://[{host}]:{port}"

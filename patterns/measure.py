@@ -371,7 +371,7 @@ def weighted_percentile(values: np.ndarray, weights: np.ndarray, q: float) -> fl
 
 def _symmetric_dirichlet(sigma: np.ndarray, weights: np.ndarray) -> float:
     with np.errstate(divide="ignore", over="ignore"):
-        return float(weights @ (sigma**2 + 1.0 / sigma**2).sum(axis=1))
+        return float(np.sum(weights * (sigma**2 + 1.0 / sigma**2).sum(axis=1)))
 
 
 def symmetric_dirichlet(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> float:
@@ -408,7 +408,8 @@ def strain_rms(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray) -> float
 
 def _principal_rms(strain: np.ndarray, area: np.ndarray) -> float:
     """``sqrt(sum_t A_t (e1**2 + e2**2) / (2 sum_t A_t))`` of principal strains ``(m, 2)`` and areas ``(m,)``."""
-    return float(np.sqrt(0.5 * (area @ (strain**2).sum(axis=1)) / area.sum()))
+    # np.sum, not a BLAS dot: the same sum whatever the thread count (a report must not depend on it)
+    return float(np.sqrt(0.5 * np.sum(area * (strain**2).sum(axis=1)) / area.sum()))
 
 
 @dataclass(frozen=True)

@@ -125,7 +125,7 @@ CLI_VALUES = [  # (flag and text, record, the API's keyword and value)
 
 BATCH_VALUES = [
     (["--jobs", "3"], "jobs", 3), (["--scheduler", "tcp://h:8786"], "scheduler", "tcp://h:8786"),
-    (["--timeout", "30"], "timeout", 30.0), (["--memory", "2048"], "memory", 2048.0),
+    (["--timeout", "30"], "timeout", 30.0), (["--memory", "2048"], "memory", 2048.0), (["--wait", "5"], "wait", 5.0),
     (["--no-report"], "report", False), (["--preview"], "preview", True), (["--heat-map"], "heat_map", True),
     (["--quiet"], "quiet", True),
 ]

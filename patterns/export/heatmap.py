@@ -93,7 +93,7 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
     ax = fig.add_subplot()
     mappable = None
     total_w = sum(float(s.area_3d.sum()) for s in strains)
-    rms = np.sqrt(sum(0.5 * float(s.area_3d @ (s.strain**2).sum(axis=1)) for s in strains) / total_w)
+    rms = np.sqrt(sum(0.5 * float(np.sum(s.area_3d * (s.strain**2).sum(axis=1))) for s in strains) / total_w)
     for flat, s, off in zip(pattern.panels, strains, offsets):
         uv = flat.uv + off
         mappable = ax.tripcolor(uv[:, 0], uv[:, 1], flat.faces, facecolors=100.0 * s.dominant, cmap="RdBu_r",
