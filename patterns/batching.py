@@ -636,10 +636,10 @@ class _DaskRunner:
         self._check_versions()
 
     def _check_versions(self) -> None:
-        from . import __version__ as mine
-
-        # A builtin, so that it unpickles anywhere: the version of the patterns that imports there.
+        # A builtin, so that it unpickles anywhere: the version of the patterns that imports there --
+        # and here, the same probe (the package is loaded already).
         probe = (eval, "__import__('patterns').__version__")
+        mine = probe[0](probe[1])
         found = self.client.run(*probe, on_error="return")
         lacking = sorted(w for w, v in found.items() if isinstance(v, ImportError))
         other = sorted(f"{w} ({v})" for w, v in found.items() if not isinstance(v, BaseException) and v != mine)

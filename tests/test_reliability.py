@@ -731,3 +731,17 @@ def test_no_option_and_no_small_mesh_breaks_a_promise(tmp_path_factory, mesh, ar
         assert after == before, argv  # refused: nothing written
     else:
         assert (folder / argv[3]).is_file(), argv
+
+
+def test_batch_progress_off_a_terminal_is_a_line_per_file_and_quiet_is_silent(tmp_path, capfd):
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    for name in ("dish.obj", "cone.obj"):
+        shutil.copy(SAMPLES / name, parts / name)
+    code, out, err = run(["batch", "parts", "-o", "out", "--jobs", "1"], tmp_path, capfd)
+    assert code == 0
+    lines = [line.split(" (")[0] for line in err.splitlines() if line.startswith("[")]
+    assert [line[:6] for line in lines] == ["[1/2] ", "[2/2] "]  # in the order they end
+    assert sorted(line[6:] for line in lines) == ["cone.obj: ok", "dish.obj: ok"]
+    code, out, err = run(["batch", "parts", "-o", "out2", "--jobs", "1", "--quiet"], tmp_path, capfd)
+    assert code == 0 and err == "" and "batch: 2 files: 2 ok" in out
