@@ -145,6 +145,10 @@ def test_copies_and_mirrored_pairs(tmp_path):
         a = np.linalg.norm(np.diff(source.outline(), axis=0, append=source.outline()[:1]), axis=1)
         b = np.linalg.norm(np.diff(flat.outline(), axis=0, append=flat.outline()[:1]), axis=1)
         assert sorted(np.round(a, 6)) == sorted(np.round(b, 6))
+        # in its own frame (before placing) a copy is its source, a mirror image its source reflected
+        flip = np.array([-1.0, 1.0]) if flat.mirrored else np.array([1.0, 1.0])
+        np.testing.assert_allclose(flat.flattening.uv, source.flattening.uv * flip, atol=1e-12)
+        assert flat.mirrored == flat.name.endswith("mirrored")
     assert patterns.check(laid).ok
     path = tmp_path / "marker.dxf"
     laid.to_dxf(path, seam_allowance=10.0)
