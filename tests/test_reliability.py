@@ -745,3 +745,22 @@ def test_batch_progress_off_a_terminal_is_a_line_per_file_and_quiet_is_silent(tm
     assert sorted(line[6:] for line in lines) == ["cone.obj: ok", "dish.obj: ok"]
     code, out, err = run(["batch", "parts", "-o", "out2", "--jobs", "1", "--quiet"], tmp_path, capfd)
     assert code == 0 and err == "" and "batch: 2 files: 2 ok" in out
+
+
+def test_sigterm_while_the_outputs_are_written_leaves_nothing(tmp_path):
+    """SIGTERM as soon as the first temporary output appears (the work done, the writing begun):
+    exit 143, one line, no output, no temporary."""
+    v, f = surfaces.paraboloid_dish(n_faces=100_000)
+    trimesh.Trimesh(v, f, process=False).export(tmp_path / "dish.obj")
+    before = snapshot(tmp_path)
+    proc = subprocess.Popen([str(EXE), "flatten", "dish.obj", "-o", "d.dxf", "--report", "d.json", "--heat-map",
+                             "h.png", "--preview", "p.png", "--strain-layer"], cwd=tmp_path,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    end = time.monotonic() + 120
+    while time.monotonic() < end and not any(p.name.startswith(".~patterns-") for p in tmp_path.iterdir()):
+        time.sleep(0.01)
+    assert any(p.name.startswith(".~patterns-") for p in tmp_path.iterdir()), "no output was being written"
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143 and err.strip() == "patterns: terminated; nothing written", err
+    assert snapshot(tmp_path) == before
