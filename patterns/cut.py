@@ -84,8 +84,11 @@ def pieces(faces: np.ndarray, n_vertices: int, *, name: str = "mesh") -> list[np
         Face indices of each piece, in order of their first face.
     """
     t = edge_tables(faces, n_vertices, name=name)
-    pairs = t.edge_faces[t.edge_faces[:, 1] >= 0]
-    m = len(faces)
+    return _face_groups(t.edge_faces[t.edge_faces[:, 1] >= 0], len(faces))
+
+
+def _face_groups(pairs: np.ndarray, m: int) -> list[np.ndarray]:
+    """The faces joined through the face ``pairs`` ``(k, 2)``, as groups in order of their first face."""
     adjacency = sp.coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(m, m))
     n, label = csgraph.connected_components(adjacency, directed=False)
     order = np.argsort(label, kind="stable")
@@ -124,14 +127,7 @@ def crease_pieces(vertices: np.ndarray, faces: np.ndarray, *, angle: float, name
     normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
     inner = t.edge_faces[t.edge_faces[:, 1] >= 0]
     cosine = np.einsum("ij,ij->i", normals[inner[:, 0]], normals[inner[:, 1]])
-    smooth = inner[cosine >= np.cos(np.radians(angle))]
-    m = len(faces)
-    graph = sp.coo_matrix((np.ones(len(smooth), dtype=np.int8), (smooth[:, 0], smooth[:, 1])), shape=(m, m))
-    n, label = csgraph.connected_components(graph, directed=False)
-    order = np.argsort(label, kind="stable")
-    groups = np.split(order, np.cumsum(np.bincount(label, minlength=n))[:-1])
-    groups.sort(key=lambda g: g[0])
-    return groups
+    return _face_groups(inner[cosine >= np.cos(np.radians(angle))], len(faces))
 
 
 def shared_chains(faces: np.ndarray, groups: list) -> list[tuple[int, int, np.ndarray]]:

@@ -140,3 +140,44 @@ def test_several_paths_are_cut_at_once():
     assert len(cut.sides) == 2
     assert len(cut.vertices) == len(v) + (len(a) - 1) + (len(b) - 1)
     assert len(validate_mesh(cut.vertices, cut.faces)[2].loops) == 1
+
+
+def test_a_closed_box_splits_at_its_creases_into_its_faces():
+    """crease_pieces on a box: six regions of two triangles, each flat; shared_chains: its twelve edges,
+    each one straight segment between two regions, as long as the box edge."""
+    import trimesh
+
+    from patterns.cut import crease_pieces, is_closed, shared_chains
+
+    box = trimesh.creation.box((100.0, 60.0, 40.0))
+    v, f = np.asarray(box.vertices), np.asarray(box.faces)
+    assert is_closed(f, len(v))
+    regions = crease_pieces(v, f, angle=60.0)
+    assert sorted(len(r) for r in regions) == [2] * 6
+    for r in regions:  # each region flat: one normal
+        p = v[f[r]]
+        n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        np.testing.assert_allclose(n, n[:1].repeat(len(n), axis=0), atol=1e-12)
+    chains = shared_chains(f, regions)
+    assert len(chains) == 12 and all(a < b for a, b, _ in chains)
+    lengths = sorted(round(float(np.linalg.norm(v[path[-1]] - v[path[0]])), 9) for _, _, path in chains)
+    assert lengths == [40.0] * 4 + [60.0] * 4 + [100.0] * 4
+    (whole,) = crease_pieces(v, f, angle=95.0)  # no edge sharper than 95 degrees: one region
+    assert sorted(whole) == list(range(12))
+
+
+def test_a_can_splits_into_caps_and_side_with_closed_rims():
+    import trimesh
+
+    from patterns.cut import crease_pieces, shared_chains
+
+    can = trimesh.creation.cylinder(radius=30.0, height=80.0, sections=32)
+    v, f = np.asarray(can.vertices), np.asarray(can.faces)
+    regions = crease_pieces(v, f, angle=60.0)
+    assert len(regions) == 3
+    chains = shared_chains(f, regions)
+    assert len(chains) == 2  # the two rims, between the side and each cap
+    for _, _, path in chains:
+        assert path[0] == path[-1] and len(path) == 33  # closed: 32 edges, the first vertex again
+        assert np.ptp(v[path, 2]) == pytest.approx(0.0, abs=1e-9)  # each rim in one plane

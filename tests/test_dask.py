@@ -103,6 +103,8 @@ class Cluster:
 
 
 def _can_hide() -> bool:
+    if shutil.which("unshare") is None:
+        return False
     return subprocess.run(["unshare", "--mount", "--propagation", "private", "true"], capture_output=True).returncode == 0
 
 
