@@ -53,9 +53,10 @@ def _venv() -> Path:
     python = VENV / "bin" / "python"
     if not python.exists():
         subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
-        meta = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
-        deps = meta["dependencies"] + meta["optional-dependencies"]["test"] + ["mutmut>=3.3"]
-        subprocess.run([str(python), "-m", "pip", "install", "-q", *deps], check=True)
+    # every time (quick when nothing is missing): a dependency added since the venv was made
+    meta = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+    deps = meta["dependencies"] + meta["optional-dependencies"]["test"] + ["mutmut>=3.3"]
+    subprocess.run([str(python), "-m", "pip", "install", "-q", *deps], check=True)
     return python
 
 
