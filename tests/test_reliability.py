@@ -764,3 +764,16 @@ def test_sigterm_while_the_outputs_are_written_leaves_nothing(tmp_path):
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == 143 and err.strip() == "patterns: terminated; nothing written", err
     assert snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize("dpi", [1e9, float("nan"), float("inf"), 0])
+def test_picture_resolutions_are_bounded(here, dpi):
+    """The API's dpi for a heat map (10-1200) and a preview (1-2400): refused, nothing written."""
+    pattern = patterns.flatten(patterns.load(here / "dish.obj"))
+    before = snapshot(here)
+    with pytest.raises(patterns.InputError, match="dpi must be a number between"):
+        pattern.heat_map(here / "h.png", dpi=dpi)
+    pattern.to_dxf(here / "d.dxf")
+    with pytest.raises(patterns.InputError, match="dpi must be a number between"):
+        patterns.preview_dxf(here / "d.dxf", here / "p.png", dpi=dpi)
+    assert set(snapshot(here)) == set(before) | {b"d.dxf"}

@@ -64,8 +64,8 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
         colour.  Default: the largest strain in the pattern.
     title : str, optional
         Default: the pattern's name with its RMS and largest strain.
-    dpi : int
-        PNG resolution.
+    dpi : float
+        PNG resolution, 10 to 1200 (the figure is 10 x 7 inches).
 
     Raises
     ------
@@ -84,6 +84,7 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
         raise InputError(f"{path}: heat maps are written as {' or '.join(HEAT_MAP_FORMATS)}, not {suffix or '(none)'!r}")
     if max_strain is not None:
         max_strain = check_number(max_strain, "max_strain", low=0, low_open=True, name=str(path))
+    dpi = check_number(dpi, "dpi", low=10, high=1200, name=str(path))  # a 10 x 7 inch figure: 100 MP at most
     offsets = display_offsets(pattern)
     strains = [p.strains for p in pattern.panels]
     worst = max(float(np.max(np.abs(s.dominant))) for s in strains)

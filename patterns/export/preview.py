@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..files import atomic_output
+from ..options import check_number
 
 __all__ = ["PREVIEW_FORMATS", "preview_dxf"]
 
@@ -66,6 +67,8 @@ def preview_dxf(dxf_path, out_path, *, dpi: float = 96, margin: float = 10.0) ->
     config = Configuration(background_policy=BackgroundPolicy.WHITE)  # paper: white, colour 7 black
 
     out_path = Path(out_path)
+    dpi = check_number(dpi, "dpi", low=1, high=2400, name=str(out_path))
+    margin = check_number(margin, "margin (mm)", low=0, high=1000, name=str(out_path))
     suffix = out_path.suffix.lower()
     if suffix not in PREVIEW_FORMATS:
         raise InputError(f"{out_path}: previews are written as {' or '.join(PREVIEW_FORMATS)}, not {suffix!r}")
