@@ -150,7 +150,7 @@ def test_a_flag_makes_the_record_the_api_makes(argv, key, name, value):
 
 
 @pytest.mark.parametrize(("flag", "text", "message"), [
-    ("--max-darts", "-1", "max_darts must be an integer >= 0, got -1"),
+    ("--max-darts", "-1", "max_darts must be an integer between 0 and 100, got -1"),
     ("--k-factor", "1.5", "k_factor must be a number between 0 and 1, got 1.5"),
     ("--text-height", "inf", "text_height must be a positive number <= 1e+07, got inf"),
     ("--max-strain", "0", "max_strain must be a positive number, got 0"),
