@@ -17,23 +17,28 @@ the drawing.
 What sparrow does not do, and so neither does this: it places no piece inside
 another's hole (an outline's holes are not offered as room), and it takes simple
 polygons only (each outline is simplified within 0.05 mm, outwards, so that the
-gap still holds on the true outline).  Its search runs for a time budget: the
-same input, seed and budget give the same marker on one machine; a faster
-machine may find a better one in the same time.
+gap still holds on the true outline).  Its search runs for a time budget, so the
+marker it stops at depends on how fast the machine ran; every marker found is
+kept (:func:`cache_folder`), so that the same pieces and options give the same
+marker again -- the promise a cutting room needs -- and a rerun is instant.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
+import os
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError, LayoutError
+from .errors import InputError, LayoutError, PatternsError
 from .options import Options, option
 from .predicates import flat_polygon
 
-__all__ = ["ROTATIONS", "SHEET_SPACING", "Layout", "LayoutError", "NestOptions", "Sheet", "layout"]
+__all__ = ["ROTATIONS", "SHEET_SPACING", "Layout", "LayoutError", "NestOptions", "Sheet", "cache_folder", "layout"]
 
 ROTATIONS = ("grain", "quarter", "free", "none")
 """How pieces may turn: ``grain`` 0 or 180 degrees (the grain stays along the roll), ``quarter``
@@ -110,8 +115,11 @@ class NestOptions(Options):
                                      repeat=True, flag="--quantity", metavar="NAME=N")
     time_limit: int = option(10, "seconds the nester searches (sparrow); longer may save a little material",
                              integer=True, low=1, high=86400, flag="--nest-time", metavar="S")
-    seed: int = option(0, "the search's seed (the same input, seed and time give the same marker on one machine)",
-                       integer=True, low=0, high=2**32 - 1, flag="--nest-seed", metavar="N")
+    seed: int = option(0, "the search's seed", integer=True, low=0, high=2**32 - 1, flag="--nest-seed",
+                       metavar="N")
+    cache: bool = option(True, "keep each marker sparrow finds and give the same one again for the same pieces "
+                               "and options (sparrow's search is bound by time, so a rerun on a busier machine "
+                               "could stop at another); --no-nest-cache searches anew", flag="--no-nest-cache")
 
     def __post_init__(self):
         super().__post_init__()
@@ -313,30 +321,78 @@ def _fits_sheet(shape, across, along, rotations) -> bool:
 
 def _solve(shapes, which, across, opts) -> dict:
     """Sparrow on the pieces ``which``: ``{piece: (angle rad, dx, dy)}`` on a roll ``across`` wide."""
-    import spyrrow
-
-    items = []
-    for k, i in enumerate(which):
-        pts = _item_points(shapes[i])
-        items.append(spyrrow.Item(str(k), [tuple(map(float, p)) for p in pts], demand=1,
-                                  allowed_orientations=_ANGLES[opts.rotations]))
+    points = [_item_points(shapes[i]) for i in which]
     # sparrow keeps every item the separation away from the strip's edges too: a strip two gaps wider,
     # and everything moved back by a gap, lets pieces touch the roll's edges (as a cutter may).
     edge = float(opts.gap)
-    instance = spyrrow.StripPackingInstance("patterns", strip_height=float(across) + 2 * edge, items=items)
-    config = spyrrow.StripPackingConfig(early_termination=True, total_computation_time=int(opts.time_limit),
-                                        min_items_separation=float(opts.gap) if opts.gap > 0 else None,
-                                        seed=int(opts.seed), num_workers=1)
-    solution = instance.solve(config)
+    task = {"items": [np.round(p, 9).tolist() for p in points], "strip": float(across) + 2 * edge,
+            "orientations": _ANGLES[opts.rotations], "gap": float(opts.gap), "time": int(opts.time_limit),
+            "seed": int(opts.seed)}
+    placed = _remembered(task) if opts.cache else None
+    if placed is None:
+        placed = _sparrow(task)
+        if opts.cache:
+            _remember(task, placed)
     out = {}
-    for placed in solution.placed_items:
-        i = which[int(placed.id)]
-        theta = np.radians(placed.rotation) % (2 * np.pi)  # in [0, 2 pi): sparrow says -180 for 180
-        tx, ty = placed.translation
+    for k, (rotation, tx, ty) in enumerate(placed):
+        theta = np.radians(rotation) % (2 * np.pi)  # in [0, 2 pi): sparrow says -180 for 180
         # sparrow's frame (x along, y across) is the piece's turned by -90 degrees; ours is sparrow's
         # turned back by +90 and moved across by the roll's width: a turn of theta, then a move.
-        out[i] = (float(theta), float(across + edge - ty), float(tx - edge))
+        out[which[k]] = (float(theta), float(across + edge - ty), float(tx - edge))
     return out
+
+
+def _sparrow(task: dict) -> list:
+    """``[(rotation deg, tx, ty)]`` per item: sparrow's answer to ``task``."""
+    import spyrrow
+
+    items = [spyrrow.Item(str(k), [tuple(p) for p in pts], demand=1, allowed_orientations=task["orientations"])
+             for k, pts in enumerate(task["items"])]
+    instance = spyrrow.StripPackingInstance("patterns", strip_height=task["strip"], items=items)
+    config = spyrrow.StripPackingConfig(early_termination=True, total_computation_time=task["time"],
+                                        min_items_separation=task["gap"] if task["gap"] > 0 else None,
+                                        seed=task["seed"], num_workers=1)
+    placed = [None] * len(items)
+    for item in instance.solve(config).placed_items:
+        placed[int(item.id)] = (float(item.rotation), *map(float, item.translation))
+    return placed
+
+
+def cache_folder() -> Path:
+    """Where markers are kept: ``$PATTERNS_CACHE``, else ``$XDG_CACHE_HOME/patterns/markers``, else
+    ``~/.cache/patterns/markers``."""
+    if os.environ.get("PATTERNS_CACHE"):
+        return Path(os.environ["PATTERNS_CACHE"])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "patterns" / "markers"
+
+
+def _key(task: dict) -> str:
+    from importlib.metadata import version
+
+    text = json.dumps({**task, "spyrrow": version("spyrrow")}, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _remembered(task: dict):
+    try:
+        data = json.loads((cache_folder() / f"{_key(task)}.json").read_text())
+        return [tuple(map(float, row)) for row in data] if len(data) == len(task["items"]) else None
+    except (OSError, ValueError, TypeError):
+        return None
+
+
+def _remember(task: dict, placed: list) -> None:
+    """Keep sparrow's answer (a cache: when it cannot be written, nothing is lost but the next search's time)."""
+    from .files import atomic_output
+
+    folder = cache_folder()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with atomic_output(folder / f"{_key(task)}.json", what="marker cache") as tmp:
+            tmp.write_text(json.dumps(placed))
+    except (OSError, PatternsError):
+        pass
 
 
 def _ends(shapes, found) -> dict:

@@ -326,11 +326,11 @@ def from_arguments(record: type, args, *, name: str | None = None, **extra):
         spec = f.metadata.get("spec")
         if spec is None or f.name in extra:
             continue
-        dest = _dest("--no-" + f.name.replace("_", "-")) if isinstance(f.default, bool) and f.default \
-            and not spec.flag else _dest(flag_of(f.name, spec))
+        negated = isinstance(f.default, bool) and f.default  # a flag that turns it off: --no-...
+        dest = _dest(spec.flag or "--no-" + f.name.replace("_", "-")) if negated else _dest(flag_of(f.name, spec))
         if not hasattr(args, dest):
             continue  # a field the parser has no flag for (skipped by add_arguments): its default
-        if isinstance(f.default, bool) and f.default and not spec.flag:
+        if negated:
             values[f.name] = not getattr(args, dest)
         else:
             value = getattr(args, dest)
@@ -346,6 +346,6 @@ def cli_flags(record: type) -> dict:
     for f in fields(record):
         spec = f.metadata.get("spec")
         if spec is not None:
-            bool_true = isinstance(f.default, bool) and f.default and not spec.flag
-            out[f.name] = "--no-" + f.name.replace("_", "-") if bool_true else flag_of(f.name, spec)
+            negated = isinstance(f.default, bool) and f.default
+            out[f.name] = (spec.flag or "--no-" + f.name.replace("_", "-")) if negated else flag_of(f.name, spec)
     return out

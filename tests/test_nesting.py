@@ -119,11 +119,24 @@ def test_only_a_pattern_is_nested():
         patterns.layout(type("Almost", (), {"panels": (), "name": "x"})(), width=100.0)
 
 
-def test_the_same_seed_gives_the_same_marker(plates):
-    a = plates.layout(width=300.0, rotations="quarter", **QUICK)
-    b = plates.layout(width=300.0, rotations="quarter", **QUICK)
+def test_the_same_pieces_and_options_give_the_same_marker(plates, _marker_cache):
+    """Sparrow's search stops on time, so a loaded machine could stop it elsewhere: every marker is kept
+    (the cache the suite points PATTERNS_CACHE at), and asked again gives the same marker, at once;
+    cache=False searches anew, for its whole budget; another seed is another search."""
+    from patterns.nesting import cache_folder
+
+    assert cache_folder() == _marker_cache
+    before = set(_marker_cache.iterdir())
+    a = plates.layout(width=300.0, rotations="quarter", seed=11, **QUICK)
+    kept = set(_marker_cache.iterdir()) - before
+    assert len(kept) == 1
+    b = plates.layout(width=300.0, rotations="quarter", seed=11, **QUICK)
     assert [f.placement for f in a.pattern.panels] == [f.placement for f in b.pattern.panels]
-    assert a.length == b.length
+    assert a.length == b.length and b.seconds < 0.5 <= a.seconds
+    fresh = plates.layout(width=300.0, rotations="quarter", seed=11, cache=False, **QUICK)
+    assert fresh.seconds >= 0.5 and set(_marker_cache.iterdir()) - before == kept
+    plates.layout(width=300.0, rotations="quarter", seed=12, **QUICK)
+    assert len(set(_marker_cache.iterdir()) - before) == 2
 
 
 def test_copies_and_mirrored_pairs(tmp_path):

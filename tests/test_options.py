@@ -118,6 +118,7 @@ CLI_VALUES = [  # (flag and text, record, the API's keyword and value)
     (["--quantity", "face0=3", "--quantity", "face1=2"], "nest", "quantities", {"face0": 3, "face1": 2}),
     (["--nest-time", "3"], "nest", "time_limit", 3),
     (["--nest-seed", "7"], "nest", "seed", 7),
+    (["--no-nest-cache"], "nest", "cache", False),
     (["--crease-angle", "45"], "load", "crease_angle", 45.0),
     (["--area-tolerance", "0.1"], "check", "area_tolerance", 0.1),
     (["--max-distortion", "3"], "check", "max_distortion", 3.0),
