@@ -655,6 +655,32 @@ def test_every_notch_starts_on_the_cut_line_and_points_into_the_piece(notched, t
                 assert not sew.buffer(-1e-6).contains(q)  # not past the seam line
 
 
+@pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
+def test_a_v_notch_opens_as_wide_as_it_is_deep(notched, tmp_path, part):
+    """notch_style="v" with a 10 mm allowance: each V is two lines from one tip (on the seam line) to two
+    mouth points on the cut line, as far from the tip as each other, the mouth 10 mm wide along the cut
+    line (as wide as the V is deep)."""
+    path = tmp_path / f"{part}.dxf"
+    notched[part].to_dxf(path, seam_allowance=10.0, notch_style="v")
+    doc = read(path)
+    cuts = _polygons(doc, "CUT")
+    lines = _notch_lines(doc)
+    assert len(lines) == 2 * 2 * 2 * len(notched[part].seams)  # two lines a V, at both ends of both sides
+    for first, second in zip(lines[0::2], lines[1::2]):  # a V's two lines are written one after the other
+        ends = []
+        for a, b in (first, second):  # the tip: the end not on the cut line
+            k = int(np.argmin([c.distance(shapely.Point((a + b) / 2)) for c in cuts]))
+            on_cut = cuts[k].exterior.distance(shapely.Point(a)) < 1e-6
+            ends.append((b, a, k) if on_cut else (a, b, k))
+        (tip0, mouth0, k), (tip1, mouth1, _) = ends
+        np.testing.assert_allclose(tip0, tip1, atol=1e-9)  # one tip
+        assert np.linalg.norm(mouth0 - tip0) == pytest.approx(np.linalg.norm(mouth1 - tip0), abs=1e-3)
+        mouths = [mouth0, mouth1]
+        ring = cuts[k].exterior
+        gap = abs(ring.project(shapely.Point(mouths[0])) - ring.project(shapely.Point(mouths[1])))
+        assert min(gap, ring.length - gap) == pytest.approx(10.0, abs=1e-3)  # as wide as deep, along the line
+
+
 @pytest.mark.parametrize("allowance", [0.0, 10.0])
 @pytest.mark.parametrize("part", ["box", "cup", "square_to_round"])
 def test_every_astm_notch_points_into_the_piece(notched, tmp_path, part, allowance):

@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import argparse
 import fnmatch
+import math
+import random
 import re
 import shutil
 import subprocess
@@ -64,11 +66,13 @@ def _chosen(name: str, only) -> bool:
     return not only or any(fnmatch.fnmatchcase(name, pattern) for pattern in only)
 
 
-def run(module: str, tests: list, python: Path, *, only=(), max_children=None) -> dict:
+def run(module: str, tests: list, python: Path, *, only=(), max_children=None, sample=None, seed=0) -> dict:
     """Run mutmut on one module in a copy of the repository: ``{"killed", "survived", "timeout", "survivors"}``.
 
     ``only``: mutant-name patterns (``patterns.export.dxf.x__notches__mutmut_*``) to run instead of
-    every mutant of the module; ``max_children``: at most this many test processes at once."""
+    every mutant of the module; ``max_children``: at most this many test processes at once;
+    ``sample``: run a uniform random sample of this many of the mutants (``seed`` picks it) -- for a
+    module whose tests are slow, an estimate of the score with its interval."""
     with tempfile.TemporaryDirectory(prefix="patterns-mutation-") as tmp:
         work = Path(tmp) / "repo"
         shutil.copytree(REPO, work, ignore=shutil.ignore_patterns(".git", ".venv", ".mutation-venv", "mutants",
@@ -81,6 +85,14 @@ def run(module: str, tests: list, python: Path, *, only=(), max_children=None) -
             fh.write(config)
         mutmut = [str(python), "-m", "mutmut"]
         children = [] if max_children is None else ["--max-children", str(max_children)]
+        total = None
+        if sample:  # make the mutants (running none), then draw the sample from their names
+            subprocess.run([*mutmut, "run", *children, "patterns.none-such"], cwd=work, capture_output=True)
+            listing = subprocess.run([*mutmut, "results", "--all", "true"], cwd=work, capture_output=True,
+                                     text=True).stdout
+            names = sorted(n for n, _ in re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M) if _chosen(n, only))
+            total = len(names)
+            only = tuple(random.Random(seed).sample(names, min(sample, total)))
         done = subprocess.run([*mutmut, "run", *children, *only], cwd=work, capture_output=True, text=True)
         listing = subprocess.run([*mutmut, "results", "--all", "true"], cwd=work, capture_output=True,
                                  text=True).stdout
@@ -91,7 +103,7 @@ def run(module: str, tests: list, python: Path, *, only=(), max_children=None) -
     if not status or all(state.strip() not in ("killed", "survived", "timeout") for _, state in status):
         # mutmut stopped before mutating (its clean run of the tests failed, say): show why
         raise SystemExit(f"mutmut made no mutants of {module}:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}")
-    out = {"killed": 0, "survived": 0, "timeout": 0, "other": 0, "survivors": [], "diffs": diffs}
+    out = {"killed": 0, "survived": 0, "timeout": 0, "other": 0, "survivors": [], "diffs": diffs, "total": total}
     for name, state in status:
         key = {"killed": "killed", "survived": "survived", "timeout": "timeout"}.get(state.strip(), "other")
         out[key] += 1
@@ -108,6 +120,9 @@ def main(argv=None) -> int:
     parser.add_argument("--max-children", type=int, default=None, help="test processes at once (default: mutmut's)")
     parser.add_argument("--tests", nargs="+", default=None, metavar="TEST",
                         help="the tests that answer for the mutants (default: the module's, as listed in MODULES)")
+    parser.add_argument("--sample", type=int, default=None, metavar="N",
+                        help="run a uniform random sample of N mutants (an estimate, with its 95 %% interval)")
+    parser.add_argument("--seed", type=int, default=0, help="the sample's seed")
     args = parser.parse_args(argv)
     python = _venv()
     total_k = total_s = 0
@@ -116,11 +131,17 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|", flush=True)
     for module in args.modules:
         tests = args.tests or MODULES.get(module, ["tests/"])
-        r = run(module, tests, python, only=args.only, max_children=args.max_children)
+        r = run(module, tests, python, only=args.only, max_children=args.max_children, sample=args.sample,
+                seed=args.seed)
         killed = r["killed"] + r["timeout"]
         total_k, total_s = total_k + killed, total_s + r["survived"]
-        score = killed / max(killed + r["survived"], 1)
-        rows.append(f"| `{module}` | {killed + r['survived']} | {killed} | {r['survived']} | {score:.1%} |")
+        n = max(killed + r["survived"], 1)
+        score = killed / n
+        note = ""
+        if r["total"] is not None:  # a sample: the normal interval of a proportion, finite population
+            half = 1.96 * math.sqrt(score * (1 - score) / n * max(r["total"] - n, 0) / max(r["total"] - 1, 1))
+            note = f" (a sample of {n} of {r['total']} mutants, seed {args.seed}; 95 % interval +-{half:.1%})"
+        rows.append(f"| `{module}` | {killed + r['survived']} | {killed} | {r['survived']} | {score:.1%}{note} |")
         print(rows[-1], flush=True)
         for name in r["survivors"]:
             print(f"survived: {name}\n{r['diffs'].get(name, '')}", file=sys.stderr, flush=True)
