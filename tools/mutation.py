@@ -66,20 +66,24 @@ def _chosen(name: str, only) -> bool:
     return not only or any(fnmatch.fnmatchcase(name, pattern) for pattern in only)
 
 
-def run(module: str, tests: list, python: Path, *, only=(), max_children=None, sample=None, seed=0) -> dict:
+def run(module: str, tests: list, python: Path, *, only=(), max_children=None, sample=None, seed=0,
+        timeout_multiplier: float = 15.0) -> dict:
     """Run mutmut on one module in a copy of the repository: ``{"killed", "survived", "timeout", "survivors"}``.
 
     ``only``: mutant-name patterns (``patterns.export.dxf.x__notches__mutmut_*``) to run instead of
     every mutant of the module; ``max_children``: at most this many test processes at once;
     ``sample``: run a uniform random sample of this many of the mutants (``seed`` picks it) -- for a
-    module whose tests are slow, an estimate of the score with its interval."""
+    module whose tests are slow, an estimate of the score with its interval; ``timeout_multiplier``:
+    mutmut's (a mutant is stopped, and counted killed, past ``2 x multiplier x`` its tests' CPU time).
+    The slow tests are left out."""
     with tempfile.TemporaryDirectory(prefix="patterns-mutation-") as tmp:
         work = Path(tmp) / "repo"
         shutil.copytree(REPO, work, ignore=shutil.ignore_patterns(".git", ".venv", ".mutation-venv", "mutants",
                                                                    "__pycache__", "*.egg-info"))
         config = (f'\n[tool.mutmut]\nsource_paths = ["patterns"]\nonly_mutate = ["{module}"]\n'
                   f"pytest_add_cli_args_test_selection = {tests!r}\nmutate_only_covered_lines = true\n"
-                  f"pytest_add_cli_args = {['-k', SKIP]!r}\n"
+                  f"pytest_add_cli_args = {['-k', SKIP, '-m', 'not slow']!r}\n"
+                  f"timeout_multiplier = {timeout_multiplier}\n"
                   'also_copy = ["samples/", "docs/"]\n').replace("'", '"')
         with open(work / "pyproject.toml", "a") as fh:
             fh.write(config)
@@ -123,6 +127,8 @@ def main(argv=None) -> int:
     parser.add_argument("--sample", type=int, default=None, metavar="N",
                         help="run a uniform random sample of N mutants (an estimate, with its 95 %% interval)")
     parser.add_argument("--seed", type=int, default=0, help="the sample's seed")
+    parser.add_argument("--timeout-multiplier", type=float, default=15.0,
+                        help="mutmut's: a mutant past 2 x this x its tests' CPU time is stopped (killed)")
     args = parser.parse_args(argv)
     python = _venv()
     total_k = total_s = 0
@@ -132,7 +138,7 @@ def main(argv=None) -> int:
     for module in args.modules:
         tests = args.tests or MODULES.get(module, ["tests/"])
         r = run(module, tests, python, only=args.only, max_children=args.max_children, sample=args.sample,
-                seed=args.seed)
+                seed=args.seed, timeout_multiplier=args.timeout_multiplier)
         killed = r["killed"] + r["timeout"]
         total_k, total_s = total_k + killed, total_s + r["survived"]
         n = max(killed + r["survived"], 1)
