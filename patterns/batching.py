@@ -634,6 +634,9 @@ class _DaskRunner:
             raise InputError(f"{self.opts.scheduler}: no Dask worker joined the scheduler within "
                              f"{self.opts.wait:g} s (start one: dask worker {address})") from None
         self._check_versions()
+        # The heavy imports now, on every worker, not inside the first file's time (a builtin, as above).
+        self.client.run(eval, "[__import__(m) for m in ('build123d', 'ezdxf', 'matplotlib.figure', 'trimesh', "
+                              "'patterns.jobs')] and None", on_error="return")
 
     def _check_versions(self) -> None:
         # A builtin, so that it unpickles anywhere: the version of the patterns that imports there --
@@ -667,7 +670,7 @@ class _DaskRunner:
         from distributed import wait
 
         pending = {}  # future -> (index, tries)
-        seen_running = {}  # future key -> when first seen processing
+        seen_running = {}  # future key -> when first seen executing
 
         def submit(index, tries):
             path = files[index]
@@ -678,7 +681,9 @@ class _DaskRunner:
             if on_start is not None and tries == 1:
                 on_start(printable(path.name))
 
-        for index in range(len(files)):
+        # The largest first, as on local processes; Dask runs tasks in the order they were submitted.
+        sizes = [files[i].stat().st_size if files[i].exists() else 0 for i in range(len(files))]
+        for index in sorted(range(len(files)), key=lambda i: -sizes[i]):
             submit(index, 1)
         while pending:
             with contextlib.suppress(Exception):  # none finished in that second, or one was lost: see below
@@ -698,7 +703,8 @@ class _DaskRunner:
                                      f"crash)"}
                 future.release()
                 yield index, row
-            running = {key for keys in self.client.processing().values() for key in keys}
+            # executing now -- not merely sent to a worker, where it may wait behind another task
+            running = {key for keys in self._executing(pending).values() for key in keys}
             now = time.monotonic()
             for future in list(pending):
                 if future.key in running:
@@ -710,6 +716,13 @@ class _DaskRunner:
                                       "reason": f"still running after {self.opts.timeout:g} s: given up (Dask "
                                                 f"cannot stop a running task; its worker ends it)",
                                       "seconds": now - started}
+
+    def _executing(self, pending) -> dict:
+        if not pending:
+            return {}
+        with contextlib.suppress(Exception):  # a worker that left meanwhile: none seen this second
+            return self.client.call_stack(keys=[f.key for f in pending])
+        return {}
 
     def close(self) -> None:
         if self.client is not None:

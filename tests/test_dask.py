@@ -303,14 +303,21 @@ def test_a_worker_killed_mid_run_loses_nothing(client_folder, cluster, capfd):
 
 
 def test_a_file_past_its_timeout_is_given_up_on_dask(client_folder, cluster, capfd):
-    v, f = surfaces.paraboloid_dish(n_faces=300_000)
+    # One worker of one thread: the slow part (the largest, so the first) runs while the others wait
+    # behind it -- on the worker too (Dask sends a thread more than one task).  Their time starts when
+    # they run, not while they wait: only the slow one is given up.
+    v, f = surfaces.paraboloid_dish(n_faces=600_000)
     trimesh.Trimesh(v, f, process=False).export(client_folder / "parts" / "slow.obj")
     address = cluster.scheduler()
-    cluster.worker(n=2)
-    cluster.wait_for(2)
-    code, out, err = _batch(["batch", "parts", "-o", "out", "--scheduler", address, "--timeout", "1"],
+    cluster.worker(n=1)
+    cluster.wait_for(1)
+    code, out, err = _batch(["batch", "parts", "-o", "out", "--scheduler", address, "--timeout", "2.5"],
                             client_folder, capfd)
     rows = {line.split()[0]: line for line in out.splitlines()[1:8]}
-    assert "timeout: still running after 1 s: given up (Dask cannot stop a running task" in rows["slow.obj"], out
-    assert not (client_folder / "out" / "slow.dxf").exists() and (client_folder / "out" / "cup.dxf").exists()
+    assert "timeout: still running after 2.5 s: given up (Dask cannot stop a running task" in rows["slow.obj"], out
+    assert "failed: broken.step: not a readable STEP file" in rows["broken.step"], out
+    for stem in ("cup", "hopper", "dish", "cone", "duct_transition"):
+        assert rows[f"{stem}{'.obj' if stem in ('dish', 'cone') else '.step'}"].endswith(" ok"), out
+        assert (client_folder / "out" / f"{stem}.dxf").exists()
+    assert not (client_folder / "out" / "slow.dxf").exists()
     assert code == 2
