@@ -73,6 +73,18 @@ def test_sizes_follow_max_edge_and_curvature(box):
         _stages(bd.Box(1000, 1000, 1000), max_edge=0.1)
 
 
+@pytest.mark.parametrize("radius, height", [(0.5, 100.0), (20.0, 30.0)])
+def test_a_cones_curvature_is_taken_by_area_not_by_sample(radius, height):
+    """A cone's normal curvature is 0 along its lines and cos(a) / r around, unbounded at the apex.
+    By area (s^2 of the area lies within slant distance s of the apex, half the weight on the lines),
+    the 95th percentile is the curvature around at the circle holding a tenth of the area:
+    cos(a) / (sqrt(0.1) R).  By sample it would be near the apex, several times larger."""
+    _, sizes, _ = _stages(bd.Cone(radius, 0, height), max_edge=None, chord_tolerance=0.05)
+    lateral = max(range(len(sizes.face_h)), key=lambda k: sizes.developments[k].curvature())
+    cos_a = height / np.hypot(radius, height)
+    assert sizes.developments[lateral].curvature() == pytest.approx(cos_a / (np.sqrt(0.1) * radius), rel=0.05)
+
+
 def test_edges_are_divided_at_equal_arc_length(box, cylinder):
     topo, _, division = box
     for e in range(12):

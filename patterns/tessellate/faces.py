@@ -193,7 +193,9 @@ def _lattice(polygon, bnd: _Boundary, h: float) -> np.ndarray:
     interior = interior[dist >= 0.55 * np.maximum(h, seg_len[near])]
     tip = _tip_points(bnd, h)
     if len(tip) and len(interior):
-        gap = np.linalg.norm(interior[:, None, :] - tip[None, :, :], axis=2).min(axis=1)
+        from scipy.spatial import cKDTree
+
+        gap, _ = cKDTree(tip).query(interior)  # not an (interior, tip) table: both can be large
         interior = interior[gap >= 0.5 * h]
     return np.concatenate([interior, tip]) if len(tip) else interior
 

@@ -61,19 +61,35 @@ class Development:
 
     def curvature(self) -> float:
         """Normal curvature between neighbouring samples, 1/mm (0 if flat): the 95th
-        percentile, so that a point where it has no bound (a cone's apex) does not
-        make the whole face fine."""
-        k = []
+        percentile by surface area, so that a small region where it has no bound (a
+        cone's apex) does not make the whole face fine.  By area, not by sample: the
+        samples are even in the parameters, and a cone's rows near the apex hold many
+        samples and little area."""
+        k, w = [], []
         size = float(np.ptp(self.points.reshape(-1, 3), axis=0).max())
+        p = self.points
+        cell = np.linalg.norm(np.cross(p[1:, 1:] - p[:-1, :-1], p[1:, :-1] - p[:-1, 1:]), axis=2) / 2  # (n-1, n-1)
+        node = np.zeros(p.shape[:2])
+        for dj, di in ((0, 0), (0, 1), (1, 0), (1, 1)):
+            node[dj:dj + cell.shape[0], di:di + cell.shape[1]] += cell / 4
         for axis in (0, 1):
             dn = np.diff(self.normals, axis=axis)
-            dp = np.diff(self.points, axis=axis)
+            dp = np.diff(p, axis=axis)
             ang = np.linalg.norm(dn, axis=2)
             dist = np.linalg.norm(dp, axis=2)
+            area = node[1:] + node[:-1] if axis == 0 else node[:, 1:] + node[:, :-1]
             ok = np.isfinite(ang) & (dist > 1e-6 * size)
             if ok.any():
                 k.append((ang[ok] / dist[ok]).ravel())
-        return float(np.percentile(np.concatenate(k), 95)) if k else 0.0
+                w.append(area[ok].ravel())
+        if not k:
+            return 0.0
+        k, w = np.concatenate(k), np.concatenate(w)
+        if not w.sum() > 0:  # no area to weigh by (a degenerate table): by sample
+            return float(np.percentile(k, 95))
+        order = np.argsort(k)
+        cum = np.cumsum(w[order])
+        return float(k[order][min(np.searchsorted(cum, 0.95 * cum[-1]), len(k) - 1)])
 
     def forward(self, uv: np.ndarray) -> np.ndarray:
         """(k, 2) parameters -> (k, 2) development coordinates, mm."""
