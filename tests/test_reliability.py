@@ -294,13 +294,13 @@ def test_a_zip_bomb_3mf_is_refused_before_it_is_inflated(tmp_path, capfd):
 
 @pytest.fixture(scope="module")
 def slow_folder(tmp_path_factory):
-    """The samples, a broken file and a part that takes seconds (a 300k-face dish)."""
+    """The samples, a broken file and a part that takes seconds (a 600k-face dish: some 5 s)."""
     parts = tmp_path_factory.mktemp("batch") / "parts"
     parts.mkdir()
     for name in ("cup.step", "dish.obj", "cone.obj", "hopper.step"):
         shutil.copy(SAMPLES / name, parts / name)
     (parts / "broken.step").write_bytes(b"garbage")
-    v, f = surfaces.paraboloid_dish(n_faces=300_000)
+    v, f = surfaces.paraboloid_dish(n_faces=600_000)
     trimesh.Trimesh(v, f, process=False).export(parts / "slow.obj")
     shutil.copy(SAMPLES / "dish.obj", parts / "slow.stl.obj")  # and a name close to it
     shutil.copy(SAMPLES / "cone.obj", parts / "cup.obj")  # a colliding pair: cup.step and cup.obj
@@ -318,10 +318,12 @@ def _rows(stdout: str) -> dict:
 
 
 def test_batch_stops_a_file_at_its_timeout_and_finishes_the_others(slow_folder, tmp_path):
-    proc = cmd(["batch", slow_folder, "-o", tmp_path / "out", "--jobs", "2", "--timeout", "1"], tmp_path, timeout=300)
+    # 2.5 s: the slow part takes some 5 s, the others under 1 s (a busy machine doubles that)
+    proc = cmd(["batch", slow_folder, "-o", tmp_path / "out", "--jobs", "2", "--timeout", "2.5"], tmp_path,
+               timeout=300)
     assert proc.returncode == 2, proc.stdout + proc.stderr
     rows = _rows(proc.stdout)
-    assert rows["slow.obj"].startswith("timeout: still running after 1 s: stopped")
+    assert rows["slow.obj"].startswith("timeout: still running after 2.5 s: stopped")
     assert rows["broken.step"].startswith("failed: broken.step: not a readable STEP file")
     written = {p.name for p in (tmp_path / "out").iterdir()}
     for name in ("cup.step", "cup.obj", "dish", "cone", "hopper", "slow.stl"):  # the pair both kept

@@ -9,7 +9,11 @@ mutmut rewrites each function of a module into many small variants ("mutants":
 a ``<`` made ``<=``, a constant changed, an argument dropped, ...) and runs the
 tests that reach that function against each; a mutant no test notices
 "survives".  The score is ``killed / (killed + survived)``, with a timeout
-counted as killed (the tests noticed: they hung).
+counted as killed (the tests noticed: they hung) -- and, beside it, the score among
+the mutants a test decided (timeouts left out): mutmut also stops a mutant on wall
+time ((its tests' time + 1 s) x the multiplier), and on a loaded machine, or where a
+test's module fixture is paid again in the mutant's own process, that stops mutants
+that did not hang.
 
 mutmut imports the package from its own copy (``mutants/``), so it cannot run
 where ``patterns`` is installed in editable mode: this script makes a separate
@@ -131,27 +135,30 @@ def main(argv=None) -> int:
                         help="mutmut's: a mutant past 2 x this x its tests' CPU time is stopped (killed)")
     args = parser.parse_args(argv)
     python = _venv()
-    total_k = total_s = 0
+    total_k = total_s = total_t = 0
     rows = []
-    print("| module | mutants | killed (timeouts included) | survived | score |")
-    print("|---|---|---|---|---|", flush=True)
+    print("| module | mutants | killed by a test | stopped on time | survived | score | score, decided only |")
+    print("|---|---|---|---|---|---|---|", flush=True)
     for module in args.modules:
         tests = args.tests or MODULES.get(module, ["tests/"])
         r = run(module, tests, python, only=args.only, max_children=args.max_children, sample=args.sample,
                 seed=args.seed, timeout_multiplier=args.timeout_multiplier)
         killed = r["killed"] + r["timeout"]
-        total_k, total_s = total_k + killed, total_s + r["survived"]
+        total_k, total_s, total_t = total_k + killed, total_s + r["survived"], total_t + r["timeout"]
         n = max(killed + r["survived"], 1)
         score = killed / n
+        decided = r["killed"] / max(r["killed"] + r["survived"], 1)
         note = ""
         if r["total"] is not None:  # a sample: the normal interval of a proportion, finite population
             half = 1.96 * math.sqrt(score * (1 - score) / n * max(r["total"] - n, 0) / max(r["total"] - 1, 1))
             note = f" (a sample of {n} of {r['total']} mutants, seed {args.seed}; 95 % interval +-{half:.1%})"
-        rows.append(f"| `{module}` | {killed + r['survived']} | {killed} | {r['survived']} | {score:.1%}{note} |")
+        rows.append(f"| `{module}` | {killed + r['survived']} | {r['killed']} | {r['timeout']} | {r['survived']} | "
+                    f"{score:.1%}{note} | {decided:.1%} |")
         print(rows[-1], flush=True)
         for name in r["survivors"]:
             print(f"survived: {name}\n{r['diffs'].get(name, '')}", file=sys.stderr, flush=True)
-    print(f"| all | {total_k + total_s} | {total_k} | {total_s} | {total_k / max(total_k + total_s, 1):.1%} |")
+    print(f"| all | {total_k + total_s} | {total_k - total_t} | {total_t} | {total_s} | "
+          f"{total_k / max(total_k + total_s, 1):.1%} | {(total_k - total_t) / max(total_k - total_t + total_s, 1):.1%} |")
     return 0
 
 
