@@ -235,6 +235,26 @@ def test_strain_layer(cup, tmp_path):
     solids = doc.modelspace().query('SOLID[layer=="STRAIN"]')
     assert len(solids) == sum(len(p.faces) for p in cup.panels)
     assert all(s.dxf.hasattr("true_color") for s in solids)
+    # Each SOLID is its flat triangle (the same area), coloured on a scale symmetric about 0:
+    # strain s at RdBu_r(1/2 + s / (2 max|s|)) of the panel, blue for compression, red for stretch.
+    from ezdxf.colors import int2rgb
+    from matplotlib import colormaps
+
+    from patterns.measure import triangle_strains
+
+    k = 0
+    for flat in cup.panels:
+        s = triangle_strains(flat.vertices, flat.faces, flat.uv).dominant
+        assert s.min() < 0 < s.max()  # both kinds on the cup
+        want = colormaps["RdBu_r"](0.5 + 0.5 * s / np.abs(s).max())[:, :3] * 255
+        a, b, c = (flat.uv[flat.faces[:, i]] for i in range(3))
+        area = 0.5 * np.abs((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])
+        for i in range(len(flat.faces)):
+            (x0, y0, _), (x1, y1, _), (x2, y2, _) = (solids[k + i].dxf.get(f"vtx{j}") for j in range(3))
+            drawn = 0.5 * abs((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0))
+            assert drawn == pytest.approx(area[i], rel=1e-6, abs=1e-9)
+            assert np.abs(np.array(int2rgb(solids[k + i].dxf.true_color)) - want[i]).max() <= 1.0
+        k += len(flat.faces)
 
 
 @pytest.mark.parametrize(
@@ -580,6 +600,26 @@ def test_each_seam_gets_its_own_allowance(tmp_path, corners):
                 assert cut.exterior.distance(shapely.Point((a + b) / 2)) == pytest.approx(allowance, abs=1e-6)
                 checked[allowance] += 1
     assert checked[5.0] > 0 and checked[15.0] > 0
+
+
+@pytest.mark.parametrize("allowance", [1.0, 10.0])
+def test_squared_corners_of_a_rectangle_are_the_rectangle_grown(tmp_path, allowance):
+    """A box's faces are rectangles: with squared corners, each cut line is its rectangle grown by
+    the allowance on every side -- (w + 2a) x (h + 2a), no more (a run carried past a corner by
+    more than the allowance, or capped round, adds area; an allowance skipped adds none)."""
+    flat = patterns.flatten(patterns.load(bd.Box(200, 100, 50), max_edge=25))
+    pattern = flat.placed([(0.0, 300.0 * k, 0.0) for k in range(len(flat.panels))])
+    path = tmp_path / "box.dxf"
+    pattern.to_dxf(path, seam_allowance=allowance, seam_corners="square")
+    doc = read(path)
+    cuts = _polygons(doc, "CUT")
+    shift = drawing_shift(doc.modelspace(), pattern, "SEW")
+    assert len(cuts) == len(pattern.panels) == 6
+    for panel in pattern.panels:
+        x0, y0, x1, y1 = shapely.Polygon(panel.uv[panel.loops[0]] + shift).bounds
+        grown = shapely.box(x0 - allowance, y0 - allowance, x1 + allowance, y1 + allowance)
+        (cut,) = [c for c in cuts if c.contains(shapely.Point((x0 + x1) / 2, (y0 + y1) / 2))]
+        assert cut.symmetric_difference(grown).area < 1e-3 * allowance
 
 
 def test_write_outline_dxf_checks_every_loop_and_writes_them_as_given(tmp_path):
