@@ -1,5 +1,7 @@
 """patterns.nesting: pieces on a roll or on sheets by sparrow, checked with shapely on the placed outlines."""
 
+import re
+
 import build123d as bd
 import ezdxf
 import numpy as np
@@ -198,6 +200,8 @@ def test_sheets_are_filled_one_after_another(plates):
         total += sum(p.area for p in mine)
     assert nest.efficiency == pytest.approx(total / (len(nest.sheets) * 400.0 * 300.0), rel=1e-9)
     assert total == pytest.approx(4 * (200 * 100 + 200 * 50 + 100 * 50), rel=1e-9)
+    n = len(nest.sheets)
+    assert str(nest).startswith(f"{n} sheet{'s' if n != 1 else ''} of 400 x 300 mm, usage ")
 
 
 def test_a_piece_too_big_for_the_sheet_is_refused(plates):
@@ -216,6 +220,31 @@ def test_a_nest_that_breaks_the_gap_is_refused_not_returned(plates):
     placed = [_outline(f, 0.0) for f in laid.panels]
     with pytest.raises(LayoutError, match="under the 10 mm gap"):
         _verify("plates", laid, placed, 5000.0, NestOptions(width=5000.0), [(0.0, -1000.0, 5000.0, None)])
+
+
+def test_with_no_gap_pieces_may_touch_but_never_overlap(plates):
+    """gap=0: two pieces that share an edge pass the shapely check; two that overlap by 1 mm are refused."""
+    from patterns.nesting import _outline, _verify
+
+    first = _outline(plates.panels[0], 0.0)
+    x1 = first.bounds[2]
+    for step, ok in ((0.0, True), (-1.0, False)):
+        laid = plates.placed([(0.0, 0.0, 0.0), (0.0, x1 + step - plates.panels[1].uv[:, 0].min(), 0.0)]
+                             + [(0.0, 1000.0 + 400.0 * k, 0.0) for k in range(4)])
+        placed = [_outline(f, 0.0) for f in laid.panels]
+        args = ("plates", laid, placed, 5000.0, NestOptions(width=5000.0, gap=0.0), [(-1e5, -1e5, 1e5, None)])
+        if ok:
+            _verify(*args)
+        else:
+            with pytest.raises(LayoutError, match="under the 0 mm gap"):
+                _verify(*args)
+
+
+@pytest.mark.parametrize(("sheet", "words"), [((1e8, 100.0), "sheet length (mm)"), ((100.0, 1e8), "sheet width (mm)"),
+                                              ((0.0, 100.0), "sheet length (mm)"), ((100.0, -5.0), "sheet width (mm)")])
+def test_a_sheet_out_of_bounds_is_named(sheet, words):
+    with pytest.raises(InputError, match=re.escape(words)):
+        NestOptions(sheet=sheet)
 
 
 def test_the_options_record_is_the_keywords(plates):

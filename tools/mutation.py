@@ -50,7 +50,7 @@ MODULES = {  # the module mutated and the tests that answer for it (its unit tes
     "patterns/nesting.py": ["tests/test_nesting.py"],
 }
 
-SKIP = "not librecad and not dxf2gcode and not freecad"
+SKIP = "not librecad and not dxf2gcode and not freecad and not inkscape and not openscad"
 """The real readers' tests are left out of the mutation runs (seconds each, in a subprocess);
 they read the same files the ezdxf tests check."""
 
@@ -88,6 +88,10 @@ def run(module: str, tests: list, python: Path, *, only=(), max_children=None, s
                   f"pytest_add_cli_args_test_selection = {tests!r}\nmutate_only_covered_lines = true\n"
                   f"pytest_add_cli_args = {['-k', SKIP, '-m', 'not slow']!r}\n"
                   f"timeout_multiplier = {timeout_multiplier}\n"
+                  # each mutant's tests in a process forked from a clean server, not from the one that
+                  # ran the suite: forked from that one, a test that calls sparrow (its thread pool
+                  # already started there) or a reader hangs, and counts as a timeout
+                  'process_isolation = "forkserver"\n'
                   'also_copy = ["samples/", "docs/"]\n').replace("'", '"')
         with open(work / "pyproject.toml", "a") as fh:
             fh.write(config)
