@@ -257,6 +257,28 @@ def test_strain_layer(cup, tmp_path):
         k += len(flat.faces)
 
 
+def test_strain_colours_are_the_version_s(cup, tmp_path):
+    """True colour from R2004 on; R2000 has none (ACI red or blue)."""
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, strain_layer=True, version="R2000")
+    solids = read(path).modelspace().query('SOLID[layer=="STRAIN"]')
+    assert len(solids) > 0 and not any(s.dxf.hasattr("true_color") for s in solids)
+    assert {s.dxf.color for s in solids} == {1, 5}
+
+
+def test_a_text_height_given_is_the_text_height(cup, tmp_path):
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, version="R12", text_height=7.0)
+    (units,) = [t for t in read(path).modelspace().query("TEXT") if t.dxf.text.startswith("UNITS:")]
+    assert units.dxf.height == 7.0
+
+
+def test_a_per_seam_allowance_is_bounded_too(cup, tmp_path):
+    with pytest.raises(InputError, match="seam_allowance"):
+        cup.to_dxf(tmp_path / "cup.dxf", seam_allowance={None: 5.0, cup.seams[0].seam.id: 1e6})
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize(
     ("kwargs", "words"),
     [
