@@ -443,6 +443,13 @@ def _environment(**values):
                 os.environ[k] = v
 
 
+def _largest_first(files) -> list[int]:
+    """The files' indices, largest file first: the longest work first balances the workers best (rows
+    still come back in whatever order they end; the batch reports them in the files' order)."""
+    sizes = [f.stat().st_size if f.exists() else 0 for f in files]
+    return sorted(range(len(files)), key=lambda i: -sizes[i])
+
+
 @dataclass
 class _Worker:
     process: object
@@ -493,10 +500,7 @@ class _LocalRunner:
     def run(self, files, records, wanted, on_start):
         from multiprocessing.connection import wait
 
-        # The largest files first (the longest work first balances the processes best); rows still come
-        # back in whatever order they end, and the batch reports them in the files' order.
-        sizes = [files[i].stat().st_size if files[i].exists() else 0 for i in range(len(files))]
-        pending = deque((i, 1) for i in sorted(range(len(files)), key=lambda i: -sizes[i]))
+        pending = deque((i, 1) for i in _largest_first(files))
         for _ in range(self.n):
             self._start()
         while pending or any(w.task for w in self.workers):
@@ -681,9 +685,7 @@ class _DaskRunner:
             if on_start is not None and tries == 1:
                 on_start(printable(path.name))
 
-        # The largest first, as on local processes; Dask runs tasks in the order they were submitted.
-        sizes = [files[i].stat().st_size if files[i].exists() else 0 for i in range(len(files))]
-        for index in sorted(range(len(files)), key=lambda i: -sizes[i]):
+        for index in _largest_first(files):  # Dask runs tasks in the order they were submitted
             submit(index, 1)
         while pending:
             with contextlib.suppress(Exception):  # none finished in that second, or one was lost: see below

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import CadError
+from ..measure import weighted_percentile
 from ..mesh import MAX_TRIANGLES
 from .topology import Topology
 
@@ -87,9 +88,7 @@ class Development:
         k, w = np.concatenate(k), np.concatenate(w)
         if not w.sum() > 0:  # no area to weigh by (a degenerate table): by sample
             return float(np.percentile(k, 95))
-        order = np.argsort(k)
-        cum = np.cumsum(w[order])
-        return float(k[order][min(np.searchsorted(cum, 0.95 * cum[-1]), len(k) - 1)])
+        return weighted_percentile(k, w, 95)
 
     def forward(self, uv: np.ndarray) -> np.ndarray:
         """(k, 2) parameters -> (k, 2) development coordinates, mm."""
