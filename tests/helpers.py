@@ -1,6 +1,10 @@
 """Helpers shared by the tests (independent of the code under test)."""
 
+import subprocess
+from pathlib import Path
+
 import numpy as np
+import pytest
 import shapely
 
 
@@ -48,3 +52,13 @@ def drawing_shift(msp, pattern, layer: str) -> np.ndarray:
             pts.append(np.array([tuple(v.dxf.location)[:2] for v in e.vertices]))
     uv = np.vstack([p.uv[np.concatenate(p.loops)] for p in pattern.panels])
     return np.vstack(pts).min(axis=0) - uv.min(axis=0)
+
+
+def small_disk(path: Path, size: str, *options) -> None:
+    """Mount a tmpfs of ``size`` (``"120k"``) at ``path`` (made here): a disk that fills up; the test is
+    skipped where mounting is not allowed.  The caller unmounts it."""
+    path.mkdir()
+    proc = subprocess.run(["mount", "-t", "tmpfs", "-o", ",".join([f"size={size}", *options]), "tmpfs", str(path)],
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        pytest.skip(f"cannot mount a small file system here ({proc.stderr.strip()})")

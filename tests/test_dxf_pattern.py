@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import shapely
 import shapely.affinity
+import trimesh
 from ezdxf import recover
 
 import patterns
@@ -23,7 +24,7 @@ from patterns.export.dxf import MACHINE_LAYERS
 from patterns.export.preview import preview_dxf
 
 from .conftest import SAMPLES
-from .helpers import drawing_shift
+from .helpers import drawing_shift, small_disk
 
 READERS = Path(__file__).parent / "readers"
 
@@ -642,6 +643,123 @@ def test_squared_corners_of_a_rectangle_are_the_rectangle_grown(tmp_path, allowa
         grown = shapely.box(x0 - allowance, y0 - allowance, x1 + allowance, y1 + allowance)
         (cut,) = [c for c in cuts if c.contains(shapely.Point((x0 + x1) / 2, (y0 + y1) / 2))]
         assert cut.symmetric_difference(grown).area < 1e-3 * allowance
+
+
+def _squared(loop, allowance):
+    """The documented squared-corner cut line of a convex polygon (vertices counter-clockwise, every
+    corner turning by more than 30 degrees), built here from its definition: each side offset
+    outwards by ``allowance`` and run straight on past both its corners by ``allowance``."""
+    poly = shapely.Polygon(loop)
+    strips = []
+    for p, q in zip(loop, np.roll(loop, -1, axis=0)):
+        t = (q - p) / np.linalg.norm(q - p)
+        n = np.array([t[1], -t[0]])  # outwards: the material lies to the left
+        a, b = p - allowance * t, q + allowance * t
+        strips.append(shapely.Polygon([a, b, b + allowance * n, a + allowance * n]))
+    return shapely.union_all([poly, *strips])
+
+
+def test_squared_corners_at_a_corner_just_past_thirty_degrees(tmp_path):
+    """A prism on a convex pentagon whose corners turn by 30.5, 75, 85, 90 and 79.5 degrees: with
+    ``seam_corners="square"`` each of its faces' cut lines, read back, is the squared outline built
+    from the definition (every corner over 30 degrees squared, the 30.5 degree one too)."""
+    turns = np.radians([30.5, 75, 85, 90, 79.5])
+    heading = np.cumsum(np.r_[0, turns[:-1]])
+    d = np.column_stack([np.cos(heading), np.sin(heading)])
+    first = np.array([120.0, 80.0, 60.0])  # the last two sides close the pentagon
+    sides = np.r_[first, np.linalg.solve(d[3:].T, -(first[:, None] * d[:3]).sum(axis=0))]
+    corners = np.vstack([[0, 0], np.cumsum(sides[:, None] * d, axis=0)[:-1]])
+    prism = bd.extrude(bd.Polygon(*[tuple(c) for c in corners], align=None), 30)
+    flat = patterns.flatten(patterns.load(prism, max_edge=10))
+    pattern = flat.placed([(0.0, 400.0 * k, 0.0) for k in range(len(flat.panels))])
+    path = tmp_path / "prism.dxf"
+    pattern.to_dxf(path, seam_allowance=8.0, seam_corners="square")
+    doc = read(path)
+    cuts = _polygons(doc, "CUT")
+    shift = drawing_shift(doc.modelspace(), pattern, "SEW")
+    checked = 0
+    for panel in pattern.panels:
+        loop = panel.uv[panel.loops[0]] + shift
+        a, b = loop - np.roll(loop, 1, axis=0), np.roll(loop, -1, axis=0) - loop
+        keep = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) > 1e-6
+        loop = loop[keep]  # its corners
+        expected = _squared(loop, 8.0)
+        (cut,) = [c for c in cuts if c.contains(shapely.Polygon(loop).representative_point())]
+        assert cut.symmetric_difference(expected).area < 1e-6 * expected.area
+        checked += len(loop) == 5
+    assert checked == 2  # the two pentagons, and the five rectangles
+
+
+def test_an_allowance_grows_the_outline_and_shrinks_the_hole(plate, tmp_path):
+    """With a 5 mm allowance every cut loop read back is its seam loop offset by 5 mm (mitred):
+    the outlines outwards, the hole's inwards -- every point of each (a loop missing one has
+    another area)."""
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, seam_allowance=5.0)
+    found = sorted(ring_numbers(pts) for pts, _ in polylines(read(path), "CUT"))
+    expected = []
+    for flat in plate.panels:
+        outline, *holes = (shapely.Polygon(flat.uv[loop]) for loop in flat.loops)
+        expected.append(outline.buffer(5.0, join_style="mitre"))
+        expected += [hole.buffer(-5.0, join_style="mitre") for hole in holes]
+    assert sum(len(flat.loops) > 1 for flat in plate.panels) == 2  # the top and the bottom have the hole
+    expected = sorted((g.area, g.exterior.length) for g in expected)
+    np.testing.assert_allclose(found, expected, rtol=1e-9)
+
+
+def test_a_panel_too_small_to_draw_is_refused_at_any_angle(tmp_path):
+    """A 6 mm-thousandths square laid out along its diagonal: 0.0085 mm across each way (under the
+    0.01 mm a DXF draws), 0.0127 mm from its lowest coordinate to its highest -- refused, by its
+    extent across, and nothing written."""
+    s = 0.006
+    trimesh.Trimesh([[0, 0, 0], [s, s, 0], [0, s, 0], [s, 0, 0]], [[0, 1, 2], [0, 3, 1]],
+                    process=False).export(tmp_path / "speck.obj")
+    pattern = patterns.flatten(patterns.load(tmp_path / "speck.obj"))
+    uv = pattern.panels[0].uv
+    assert np.ptp(uv, axis=0).max() < 0.01 < np.ptp(uv)  # the case: its coordinates span more than it does
+    for profile in ("machine", "astm"):
+        with pytest.raises(InputError, match=rf"a panel {s * np.sqrt(2):.3g} mm across, under the 0.01 mm"):
+            pattern.to_dxf(tmp_path / "speck.dxf", profile=profile)
+    assert not (tmp_path / "speck.dxf").exists()
+
+
+@pytest.mark.parametrize("profile", ["machine", "astm"])
+def test_a_full_disk_is_named_and_leaves_nothing(cup, tmp_path, profile):
+    disk = tmp_path / "disk"
+    small_disk(disk, "24k")
+    try:
+        with pytest.raises(ExportError, match=r"cup.dxf: cannot write the DXF file \(No space left on device\)"):
+            cup.to_dxf(disk / "cup.dxf", profile=profile)
+        assert list(disk.iterdir()) == []  # no partial file, no temporary
+    finally:
+        subprocess.run(["umount", str(disk)], check=False)
+
+
+def test_notches_off_a_corner_are_square_to_the_outline(notched, tmp_path):
+    """Without an allowance, a notch every 1.5 mm along the box's seams: the last of each lies
+    0.5 mm before the end of a 50 or 200 mm seam, a corner of the outline. Every notch not on a corner is a snip
+    square to the straight line it is on (a notch near a corner taken for one at it would run
+    along the corner's bisector)."""
+    pattern = notched["box"]
+    path = tmp_path / "box.dxf"
+    pattern.to_dxf(path, notch_spacing=1.5)
+    doc = read(path)
+    cuts = _polygons(doc, "CUT")
+    near_corners = 0
+    for a, b in _notch_lines(doc):
+        cut = cuts[int(np.argmin([c.distance(shapely.Point((a + b) / 2)) for c in cuts]))]
+        ring = np.asarray(cut.exterior.coords)
+        corner = np.linalg.norm(ring - a, axis=1).min()
+        if corner < 1e-6:
+            continue
+        near_corners += corner < 1.0
+        edges = [k for k in range(len(ring) - 1)
+                 if shapely.LineString(ring[k:k + 2]).distance(shapely.Point(a)) < 1e-6]
+        (k,) = edges
+        along = (ring[k + 1] - ring[k]) / np.linalg.norm(ring[k + 1] - ring[k])
+        assert abs(along @ (b - a)) / np.linalg.norm(b - a) < 1e-9
+    # the 0.5 mm ones were there and were checked: both sides of each 200 and 50 mm seam (100 = 66 x 1.5 + 1)
+    assert near_corners == 2 * sum(1 for fs in pattern.seams if fs.length % 1.5 == pytest.approx(0.5))
 
 
 def test_write_outline_dxf_checks_every_loop_and_writes_them_as_given(tmp_path):

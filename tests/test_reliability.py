@@ -28,6 +28,7 @@ import patterns
 from patterns import cli, surfaces
 
 from .conftest import SAMPLES
+from .helpers import small_disk
 
 EXE = Path(sys.executable).with_name("patterns")
 
@@ -204,17 +205,9 @@ def test_an_output_that_is_a_folder(here, capfd):
     refused(["flatten", "dish.obj", "-o", "x.dxf"], here, capfd, "x.dxf: is a folder")
 
 
-def _tmpfs(path: Path, size: str, *options):
-    path.mkdir()
-    proc = subprocess.run(["mount", "-t", "tmpfs", "-o", ",".join([f"size={size}", *options]), "tmpfs", str(path)],
-                          capture_output=True, text=True)
-    if proc.returncode != 0:
-        pytest.skip(f"cannot mount a small file system here ({proc.stderr.strip()})")
-
-
 def test_a_full_disk_leaves_nothing_behind(tmp_path):
     disk = tmp_path / "disk"
-    _tmpfs(disk, "120k")
+    small_disk(disk, "120k")
     try:
         shutil.copy(SAMPLES / "cup.step", disk / "cup.step")
         before = snapshot(disk)

@@ -170,7 +170,7 @@ ASTM_LAYERS = {1: "cut line, piece text", 2: "turn points", 3: "curve points", 4
 class _PanelGeometry:
     """Flat geometry of one panel as it goes into the file (mm, placed)."""
 
-    def __init__(self, pattern, index, offset, allowances, text_height, corners="mitre"):
+    def __init__(self, pattern, index, offset, allowances, text_height, corners):
 
         flat = pattern.panels[index]
         self.name = printable(flat.name)  # names are data: no control character reaches the file
@@ -218,7 +218,7 @@ def _segment_seams(pattern, index) -> dict:
     return out
 
 
-def _allowance_outline(polygon, loops, per_segment, corners="mitre"):
+def _allowance_outline(polygon, loops, per_segment, corners):
     """The cut outline: the seam line offset outwards by each segment's allowance.
 
     ``corners="mitre"``: offset lines meet at a point (mitre limit 4).
