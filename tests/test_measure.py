@@ -171,3 +171,18 @@ def test_folded_means_not_positive_at_any_size():
                 - (collapsed[f[:, 1]] - collapsed[f[:, 0]])[:, 1] * (collapsed[f[:, 2]] - collapsed[f[:, 0]])[:, 0])
     assert np.any(sa == 0.0)
     assert measure.distortion(v, f, collapsed).n_folded == int(np.count_nonzero(sa <= 0.0))
+    np.testing.assert_array_equal(measure.folded_faces(collapsed, f), np.flatnonzero(sa <= 0.0))
+
+
+def test_no_strain_is_an_isometry_read_only():
+    """What an exact development reports: two stretches of 1 per triangle, strains 0, the 3D areas as
+    weights -- and, like every TriangleStrain, arrays nobody can change afterwards."""
+    v = np.array([[0, 0, 0], [4, 0, 0], [0, 3, 0], [0, 0, 5]], dtype=float)
+    f = np.array([[0, 1, 2], [0, 1, 3]])
+    ts = measure.no_strain(v, f)
+    np.testing.assert_array_equal(ts.stretch, np.ones((2, 2)))
+    np.testing.assert_array_equal(ts.strain, np.zeros((2, 2)))
+    np.testing.assert_array_equal(ts.area_3d, [6.0, 10.0])
+    for name in ("stretch", "strain", "dominant", "direction", "area_change", "area_3d"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(ts, name)[0] = 7.0
