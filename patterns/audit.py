@@ -15,7 +15,6 @@ import shapely
 from .errors import InputError
 from .files import atomic_output
 from .measure import edge_strain, folded_faces, strain_stats
-from .mesh import _readonly
 from .options import Options, option
 from .pattern import Pattern
 from .predicates import Overlap, boundary_crossings, crossing_segments, flat_polygon, overlap_verdict
@@ -73,7 +72,8 @@ class Finding:
         triangles, a point inside an overlap, the worst triangle's centre).
     faces : (j,) int64
         Triangles concerned (folded, or above the strain limit), indices into
-        the panel's faces; empty when not about triangles.
+        the panel's faces; empty when not about triangles.  ``points`` and
+        ``faces`` are the finding's own copies, read-only.
     seam : int or None
         The seam concerned.
     message : str
@@ -87,6 +87,12 @@ class Finding:
     faces: np.ndarray
     seam: int | None
     message: str
+
+    def __post_init__(self):
+        for name, dtype in (("points", np.float64), ("faces", np.int64)):  # the finding's own, read-only
+            value = np.array(getattr(self, name), dtype=dtype)
+            value.setflags(write=False)
+            object.__setattr__(self, name, value)
 
     def to_dict(self) -> dict:
         return {
@@ -244,7 +250,7 @@ class Report:
         """Write :meth:`to_dict` as JSON (atomically: a failed write leaves no file)."""
         import json
 
-        text = json.dumps(self.to_dict(), indent=2, sort_keys=False, allow_nan=False)
+        text = json.dumps(self.to_dict(), indent=2, allow_nan=False)  # in the order shown; never a NaN
         with atomic_output(path, what="report") as tmp:
             tmp.write_text(text + "\n", encoding="utf-8")
 
@@ -345,7 +351,7 @@ def _usable(flat, report, opts) -> list:
     change = report.area_flat / report.area_3d - 1.0 if report.area_3d > 0 else 0.0
     at = np.array([report.strain_max_at])
     if opts.area_tolerance is not None and abs(change) > opts.area_tolerance:
-        out.append(Finding(Code.AREA_NOT_KEPT, Severity.ERROR, (name,), _readonly(at), none, None,
+        out.append(Finding(Code.AREA_NOT_KEPT, Severity.ERROR, (name,), at, none, None,
                            f"panel {name}: flat area {report.area_flat:.1f} mm^2 is {abs(change):.1%} "
                            f"{'smaller' if change < 0 else 'larger'} than its 3D area {report.area_3d:.1f} mm^2 "
                            f"(tolerance {opts.area_tolerance:.1%}): not a usable pattern of this surface; give it "
@@ -359,8 +365,8 @@ def _usable(flat, report, opts) -> list:
         if share > GROSS_SHARE:
             worst = gross[np.argmax(factor[gross])]
             c = flat.uv[flat.faces[worst]].mean(axis=0)
-            out.append(Finding(Code.GROSSLY_DISTORTED, Severity.ERROR, (name,), _readonly(c[None, :]),
-                               _readonly(gross), None,
+            out.append(Finding(Code.GROSSLY_DISTORTED, Severity.ERROR, (name,), c[None, :],
+                               gross, None,
                                f"panel {name}: {share:.1%} of its area is laid flat at more than "
                                f"{opts.max_distortion:g} times its size, or 1/{opts.max_distortion:g} of it, in some "
                                f"direction (worst at ({c[0]:.1f}, {c[1]:.1f}) mm): not a usable pattern of this "
@@ -389,7 +395,7 @@ def _panel_report(flat, max_strain):
             worst = above[np.argmax(mag[above])]
             centre = uv[faces[worst]].mean(axis=0)
             findings.append(Finding(
-                Code.STRAIN_ABOVE_LIMIT, Severity.LIMIT, (flat.name,), centre[None, :], _readonly(above), None,
+                Code.STRAIN_ABOVE_LIMIT, Severity.LIMIT, (flat.name,), centre[None, :], above, None,
                 f"panel {flat.name}: strain above {max_strain:.2%} on {share:.1%} of its area "
                 f"({len(above)} triangles), up to {mag[worst]:.2%} at ({centre[0]:.1f}, {centre[1]:.1f}) mm"))
     findings += _panel_overlaps(flat)
@@ -398,7 +404,7 @@ def _panel_report(flat, max_strain):
     if flat.darts:
         tips = np.array([uv[d.tip] for d in flat.darts])
         length = sum(d.length_3d for d in flat.darts)
-        findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), _readonly(tips), none,
+        findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), tips, none,
                                 None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
                                       f"the limit ({length:.1f} mm of cuts; points: their tips)"))
     if not res.converged:
@@ -458,7 +464,7 @@ def _panel_overlaps(flat) -> list:
     if len(folded):
         centres = uv[faces[folded]].mean(axis=1)
         c = centres[0]
-        out.append(Finding(Code.FOLDED_TRIANGLES, Severity.ERROR, (name,), _readonly(centres), _readonly(folded), None,
+        out.append(Finding(Code.FOLDED_TRIANGLES, Severity.ERROR, (name,), centres, folded, None,
                            f"panel {name}: {len(folded)} folded triangles (first: face {int(folded[0])} "
                            f"at ({c[0]:.1f}, {c[1]:.1f}) mm)"))
     for a, b, pts in boundary_crossings(uv, loops):
@@ -466,7 +472,7 @@ def _panel_overlaps(flat) -> list:
         what = ("its outline crosses itself" if a == b == 0 else
                 f"hole {b} crosses the outline" if a == 0 else
                 f"hole {a} crosses itself" if a == b else f"holes {a} and {b} cross")
-        out.append(Finding(code, Severity.ERROR, (name,), _readonly(pts), none, None,
+        out.append(Finding(code, Severity.ERROR, (name,), pts, none, None,
                            f"panel {name}: {what} at {len(pts)} points (first: ({pts[0, 0]:.1f}, {pts[0, 1]:.1f}) mm)"))
     rings = [shapely.linearrings(uv[loop]) for loop in loops]
     if not shapely.is_ccw(rings[0]):
@@ -504,6 +510,6 @@ def _overlaps_between(pattern) -> list:
             continue  # touching along an edge or at a point
         p = shapely.get_coordinates(shapely.point_on_surface(common))[0]
         na, nb = pattern.panels[a].name, pattern.panels[b].name
-        out.append(Finding(Code.PANELS_OVERLAP, Severity.ERROR, (na, nb), _readonly(p[None, :]), none, None,
+        out.append(Finding(Code.PANELS_OVERLAP, Severity.ERROR, (na, nb), p[None, :], none, None,
                            f"panels {na} and {nb} overlap by {area:.1f} mm^2 around ({p[0]:.1f}, {p[1]:.1f}) mm"))
     return out

@@ -29,13 +29,17 @@ import hashlib
 import json
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from importlib.metadata import version
 from pathlib import Path
 
 import numpy as np
+import shapely
+from shapely import affinity
 
 from .errors import InputError, LayoutError, PatternsError
-from .options import Options, option
+from .files import atomic_output
+from .options import Options, check_number, option
 from .predicates import flat_polygon
 
 __all__ = ["ROTATIONS", "SHEET_SPACING", "Layout", "LayoutError", "NestOptions", "Sheet", "cache_folder", "layout"]
@@ -60,8 +64,6 @@ def _sheet(value, option_name):
         length, width = (float(x) for x in value)
     except (TypeError, ValueError):
         raise InputError(f"{option_name} must be (length, width) in mm, got {value!r}") from None
-    from .options import check_number
-
     return (check_number(length, f"{option_name} length (mm)", low=0, low_open=True, high=1e7),
             check_number(width, f"{option_name} width (mm)", low=0, low_open=True, high=1e7))
 
@@ -81,8 +83,6 @@ def _quantities(value, option_name):
         items = dict(value).items()
     except (TypeError, ValueError):
         raise InputError(f"{option_name} must map panel names to counts, e.g. {{'sleeve': 2}}") from None
-    from .options import check_number
-
     return {str(k): check_number(n, f"{option_name}[{k!r}]", low=1, high=10000, integer=True) for k, n in items}
 
 
@@ -259,8 +259,6 @@ def layout(pattern, options: NestOptions | None = None, **keywords) -> Layout:
         used = across * length
         rects = ((0.0, 0.0, across, length),)
     result = Layout(None, float(across), float(length), float(used), area_pieces, tuple(sheets), seconds, opts)
-    from dataclasses import replace
-
     laid = replace(laid, stock=rects, stock_note=str(result))
     return replace(result, pattern=laid)
 
@@ -274,8 +272,6 @@ def _outline(flat, margin: float):
 def _item_points(shape) -> np.ndarray:
     """The outline offered to sparrow: grown and simplified within SIMPLIFY, in its frame (x along the
     strip = the piece's +Y, y across = its -X)."""
-    import shapely
-
     simple = shapely.simplify(shape.buffer(SIMPLIFY, join_style="mitre"), SIMPLIFY)
     if simple.geom_type != "Polygon":
         simple = max(getattr(simple, "geoms", [simple]), key=lambda g: g.area)
@@ -283,22 +279,15 @@ def _item_points(shape) -> np.ndarray:
     return np.column_stack([pts[:, 1], -pts[:, 0]])
 
 
-def _extent_across(shape, rotations: str) -> tuple[float, float]:
-    """The least width the piece takes across the strip, and its length along it then, over the turns allowed."""
-    from shapely import affinity
-
+def _least_width(shape, rotations: str) -> float:
+    """The least width (mm) the piece takes across the strip, over the turns allowed."""
     angles = _ANGLES[rotations]
     angles = np.arange(0.0, 180.0, 1.0) if angles is None else angles
-    best = None
-    for a in angles:
-        x0, y0, x1, y1 = affinity.rotate(shape, a, origin=(0, 0)).bounds
-        if best is None or (x1 - x0) < best[0]:
-            best = (x1 - x0, y1 - y0)
-    return best
+    return min(float(np.ptp(shapely.get_coordinates(affinity.rotate(shape, a, origin=(0, 0)))[:, 0])) for a in angles)
 
 
 def _check_fits(name, piece, shape, across, along, rotations):
-    width, length = _extent_across(shape, rotations)
+    width = _least_width(shape, rotations)
     if width > across + 1e-9:
         what = f"{across:g} mm roll" if along is None else f"{along:g} x {across:g} mm sheet"
         raise LayoutError(f"{name}: piece {piece} is {width:.1f} mm wide, wider than the {what} in every allowed "
@@ -309,8 +298,6 @@ def _check_fits(name, piece, shape, across, along, rotations):
 
 
 def _fits_sheet(shape, across, along, rotations) -> bool:
-    from shapely import affinity
-
     angles = _ANGLES[rotations]
     for a in (np.arange(0.0, 180.0, 1.0) if angles is None else angles):
         x0, y0, x1, y1 = affinity.rotate(shape, a, origin=(0, 0)).bounds
@@ -368,8 +355,6 @@ def cache_folder() -> Path:
 
 
 def _key(task: dict) -> str:
-    from importlib.metadata import version
-
     text = json.dumps({**task, "spyrrow": version("spyrrow")}, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -384,8 +369,6 @@ def _remembered(task: dict):
 
 def _remember(task: dict, placed: list) -> None:
     """Keep sparrow's answer (a cache: when it cannot be written, nothing is lost but the next search's time)."""
-    from .files import atomic_output
-
     folder = cache_folder()
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -397,8 +380,6 @@ def _remember(task: dict, placed: list) -> None:
 
 def _ends(shapes, found) -> dict:
     """How far along the strip each placed piece reaches, mm."""
-    from shapely import affinity
-
     return {i: affinity.translate(affinity.rotate(shapes[i], angle, origin=(0, 0), use_radians=True), dx, dy).bounds[3]
             for i, (angle, dx, dy) in found.items()}
 
@@ -408,8 +389,6 @@ def _fill_sheets(shapes, pieces, opts):
     sheet's length kept on it; then each piece left over, largest first, tried on that sheet too (a short
     search of the sheet's pieces and it, kept if all fit), until the sheet's time is spent; the rest go on
     to the next sheet."""
-    from dataclasses import replace
-
     length, width = opts.sheet
     left = list(range(len(shapes)))
     placements, sheets, stock = {}, [], []
@@ -421,7 +400,6 @@ def _fill_sheets(shapes, pieces, opts):
         on_sheet = [i for i in left if ends[i] <= length + 1e-9]
         if not on_sheet:  # the nearest piece alone, from the start of the sheet
             i = min(left, key=lambda j: found[j][2])
-            angle, dx, dy = found[i]
             found = _solve(shapes, [i], width, trial)
             on_sheet = [i]
         found = {i: found[i] for i in on_sheet}
@@ -445,8 +423,6 @@ def _fill_sheets(shapes, pieces, opts):
 
 def _verify(name, laid, placed, across, opts, stock) -> None:
     """Raise LayoutError unless every gap holds, no two pieces overlap, and all lie on the stock."""
-    import shapely
-
     tol = 1e-6 * max(across, 1.0)
     tree = shapely.STRtree(placed)
     left, right = tree.query(placed, predicate="dwithin", distance=max(opts.gap - tol, 0.0))

@@ -116,7 +116,7 @@ def test_overlapping_layout_is_caught_with_the_place_named(cup):
     assert patterns.check(cup.placed(apart)).ok
     shifted = list(apart)
     shifted[1] = (0.0, 0.4 * width, 0.0)
-    report = patterns.check(cup.placed(shifted))
+    report = well_formed(patterns.check(cup.placed(shifted)), cup)
     (finding,) = [f for f in report.findings if f.code is Code.PANELS_OVERLAP]
     assert finding.severity is Severity.ERROR and finding.panels == ("face0", "face1") and not report.ok
     import shapely
@@ -179,8 +179,11 @@ def test_seam_mismatch_limit(cup):
     free = patterns.flatten(cup.model, seams="free")
     report = patterns.check(free, max_seam_mismatch=0.001)
     worst = max(abs(s.mismatch) for s in report.seams)
-    found = [f for f in report.findings if f.code is Code.SEAM_MISMATCH_ABOVE_LIMIT]
+    found = [f for f in well_formed(report, free).findings if f.code is Code.SEAM_MISMATCH_ABOVE_LIMIT]
     assert len(found) == sum(abs(s.mismatch) > 0.001 for s in report.seams) >= 1
+    for f in found:
+        (row,) = [s for s in report.seams if s.id == f.seam]
+        assert f.panels == row.panels and abs(row.mismatch) > 0.001
     assert worst > 0.001
     assert patterns.check(free, max_seam_mismatch=10.0).ok
 
@@ -195,9 +198,17 @@ def test_seams_held_at_their_length_and_a_seam_that_was_not(cup):
         for flat in s.length_flat:
             assert flat == pytest.approx(s.length_3d_polyline, rel=2e-4)
     short = patterns.flatten(cup.model, max_iterations=2)
-    findings = [f for f in patterns.check(short).findings if f.code is Code.SEAM_LENGTH_NOT_KEPT]
+    report = well_formed(patterns.check(short), short)
+    findings = [f for f in report.findings if f.code is Code.SEAM_LENGTH_NOT_KEPT]
     assert findings and all(f.severity is Severity.LIMIT and f.seam is not None for f in findings)
-    assert "could not be held" in findings[0].message
+    for f in findings:  # the side furthest off its held length, with its numbers
+        (row,) = [s for s in report.seams if s.id == f.seam]
+        side = int(np.argmax([abs(row.length_flat[k] / row.length_held[k] - 1) for k in (0, 1)]))
+        got, want = row.length_flat[side], row.length_held[side]
+        assert abs(got / want - 1) > 1e-3
+        assert f.message == (f"seam {row.id} ({row.panels[0]} / {row.panels[1]}): could not be held at its length "
+                             f"(folds in the way, or the relaxation stopped early): {got:.2f} mm flat on "
+                             f"{row.panels[side]}'s side, {want:.2f} mm wanted ({100 * (got / want - 1):+.2f} %)")
 
 
 def test_json_report_round_trips_with_its_schema(cup, tmp_path):
@@ -305,8 +316,33 @@ def holed():
     return pattern, next(i for i, flat in enumerate(pattern.panels) if len(flat.loops) == 2)
 
 
+def well_formed(report, pattern):
+    """Every finding as documented (patterns.audit.Finding): a Code and a Severity, the names of the
+    pattern's panels it is about, points (k, 2) float64 and faces (j,) int64 of that panel (read-only),
+    the seam's id or None, a one-line message starting with what it is about."""
+    names = [flat.name for flat in pattern.panels]
+    seams = {fs.seam.id for fs in pattern.seams}
+    for f in report.findings:
+        assert isinstance(f.code, Code) and isinstance(f.severity, Severity)
+        assert isinstance(f.panels, tuple) and all(name in names for name in f.panels), f
+        assert f.points.dtype == np.float64 and f.points.ndim == 2 and f.points.shape[1] == 2
+        assert f.faces.dtype == np.int64 and f.faces.ndim == 1
+        assert not f.points.flags.writeable and not f.faces.flags.writeable
+        if len(f.faces):
+            assert f.faces.max() < len(pattern.panels[names.index(f.panels[0])].faces)
+        assert f.seam is None or f.seam in seams
+        assert "\n" not in f.message
+        if f.seam is not None:
+            assert f.message.startswith(f"seam {f.seam} ({f.panels[0]} / {f.panels[1]}): ")
+        elif len(f.panels) == 2:
+            assert f.message.startswith(f"panels {f.panels[0]} and {f.panels[1]} ")
+        else:
+            assert f.message.startswith(f"panel {f.panels[0]}: ")
+    return report
+
+
 def _codes(pattern):
-    return {f.code for f in patterns.check(pattern).findings}
+    return {f.code for f in well_formed(patterns.check(pattern), pattern).findings}
 
 
 def test_outline_crossing_itself_is_a_finding():
@@ -368,6 +404,51 @@ def test_a_panel_laid_at_the_wrong_size_is_not_usable(cup):
     assert len(gross.faces) == len(flat.faces)
     assert Code.GROSSLY_DISTORTED not in _codes(_with_uv(cup, 0, flat.uv * [1.7, 1 / 1.7]))  # x 1.7 x its 12 %: < 2
     assert Code.GROSSLY_DISTORTED not in _codes(cup)
+
+
+def test_two_placed_panels_that_overlap_are_found(cup):
+    """A pattern of just two panels, placed overlapping: the overlap is found (and not once placed apart)."""
+    from dataclasses import replace
+
+    two = replace(cup, panels=cup.panels[:2], seams=())
+    width = np.ptp(cup.panels[0].uv[:, 0])
+    assert Code.PANELS_OVERLAP in _codes(two.placed([(0.0, 0.0, 0.0), (0.0, 0.4 * width, 0.0)]))
+    assert Code.PANELS_OVERLAP not in _codes(two.placed([(0.0, 0.0, 0.0), (0.0, 3 * width, 0.0)]))
+
+
+def test_a_panel_squeezed_to_less_than_half_is_grossly_distorted(cup):
+    """Squeezed to 0.4 of its width (stretched nowhere), the panel is laid at 1/2.5 of its size across:
+    grossly distorted, as a panel stretched 2.5 times would be; the area finding is placed at the worst
+    strain the panel's report gives."""
+    flat = cup.panels[0]
+    for squeeze in ([0.4, 1.0], [1.0, 0.4]):
+        squeezed = _with_uv(cup, 0, flat.uv * squeeze)
+        report = well_formed(patterns.check(squeezed), squeezed)
+        codes = {f.code for f in report.findings}
+        assert Code.GROSSLY_DISTORTED in codes and Code.AREA_NOT_KEPT in codes
+        (area,) = [f for f in report.findings if f.code is Code.AREA_NOT_KEPT]
+        np.testing.assert_array_equal(area.points, [report.panels[0].strain_max_at])
+
+
+def test_a_collapsed_triangle_counts_as_folded_in_the_report():
+    """A triangle laid flat with no area (a vertex on the opposite side) is folded: the report's
+    n_folded counts it, as the signed areas say."""
+    from patterns.reading import mesh_model
+
+    st, f = surfaces.grid_mesh(6, 6)
+    v = np.column_stack([st * 50.0, np.zeros(len(st))])
+    plane = patterns.flatten(mesh_model(v, f), method="isometric")
+    flat = plane.panels[0]
+    uv = np.array(flat.uv)
+    boundary = np.zeros(len(uv), dtype=bool)
+    boundary[np.concatenate(flat.loops)] = True
+    a, b, c = next(t for t in flat.faces if not boundary[t].any())  # an interior triangle
+    uv[c] = (uv[a] + uv[b]) / 2
+    collapsed = _with_uv(plane, 0, uv)
+    sa = patterns.measure.signed_areas(uv, flat.faces)
+    assert np.any(sa == 0.0)
+    report = well_formed(patterns.check(collapsed), collapsed)
+    assert report.panels[0].n_folded == int(np.count_nonzero(sa <= 0.0)) > 0
 
 
 def test_a_relaxation_stopped_early_is_a_note(cup):

@@ -1,5 +1,6 @@
 """patterns.nesting: pieces on a roll or on sheets by sparrow, checked with shapely on the placed outlines."""
 
+import json
 import re
 
 import build123d as bd
@@ -245,6 +246,87 @@ def test_with_no_gap_pieces_may_touch_but_never_overlap(plates):
 def test_a_sheet_out_of_bounds_is_named(sheet, words):
     with pytest.raises(InputError, match=re.escape(words)):
         NestOptions(sheet=sheet)
+
+
+@pytest.mark.parametrize(("value", "words"), [
+    ({"face0": 0}, "quantities['face0'] must be an integer between 1 and 10000, got 0"),
+    ({"face0": 10001}, "got 10001"), ({"face0": 2.5}, "got 2.5"), ({"face0": True}, "got True"),
+    (5, "quantities must map panel names to counts, e.g. {'sleeve': 2}")])
+def test_quantities_are_whole_counts_within_bounds(value, words):
+    with pytest.raises(InputError, match=re.escape(words)):
+        NestOptions(width=100.0, quantities=value)
+    assert NestOptions(width=100.0, quantities={"a": 1, 7: 10000}).quantities == {"a": 1, "7": 10000}
+
+
+@pytest.mark.parametrize("value", [(100.0,), "ab", (1, 2, 3), {"length": 100.0}])
+def test_a_sheet_is_two_numbers(value):
+    with pytest.raises(InputError, match=r"sheet must be \(length, width\) in mm, got"):
+        NestOptions(sheet=value)
+
+
+def test_every_input_of_a_search_is_in_its_marker_key():
+    """The marker cache's key: the same for the same search (whatever the order its fields come in),
+    another for a change to any one of them -- the outlines, the strip, the turns, the gap, the time,
+    the seed -- so that a kept marker is only ever given back to the search that found it."""
+    from patterns.nesting import _key
+
+    task = {"items": [[[0.0, 0.0], [100.0, 0.0], [0.0, 50.0]]], "strip": 320.0, "orientations": [0.0, 180.0],
+            "gap": 10.0, "time": 10, "seed": 0}
+    assert _key(dict(reversed(task.items()))) == _key(task)
+    changed = {"items": [[[0.0, 0.0], [100.0, 0.0], [0.0, 50.5]]], "strip": 320.5, "orientations": [0.0],
+               "gap": 5.0, "time": 11, "seed": 1}
+    keys = {_key(task)} | {_key({**task, field: value}) for field, value in changed.items()}
+    assert len(keys) == 1 + len(changed)
+    assert all(re.fullmatch(r"[0-9a-f]{64}", k) for k in keys)  # a file name on any system
+
+
+def test_the_cache_folder_is_made_and_a_broken_marker_searched_anew(plates, tmp_path, monkeypatch):
+    """The cache folder is made (parents too) at the first marker kept; a kept file that is not a marker
+    (cut short, edited, another version's) is never used: the search runs again and keeps a good one."""
+    from patterns.nesting import cache_folder
+
+    monkeypatch.setenv("PATTERNS_CACHE", str(tmp_path / "deep" / "er" / "markers"))
+    first = plates.layout(width=300.0, seed=5, time_limit=1)
+    (kept,) = cache_folder().iterdir()
+    for broken in ("[[0.0, 1.0", "[]", '{"a": 1}', "[[0, 1, 2]]"):
+        kept.write_text(broken)
+        again = plates.layout(width=300.0, seed=5, time_limit=1)
+        assert again.seconds >= 0.5  # searched anew
+        assert patterns.check(again.pattern).ok and len(again.pattern.panels) == len(plates.panels)
+        assert len(json.loads(kept.read_text())) == len(plates.panels)  # and the good marker kept again
+    assert first.length > 0
+
+
+def test_sheets_lie_a_sheet_spacing_apart(plates):
+    """The sheets of a nest are drawn one after another along the roll's direction, SHEET_SPACING apart:
+    sheet k from k x (length + spacing)."""
+    from patterns.nesting import SHEET_SPACING
+
+    nest = plates.layout(sheet=(300.0, 250.0), copies=2, **QUICK)
+    assert len(nest.sheets) >= 2
+    for k, rect in enumerate(nest.pattern.stock):
+        assert rect == pytest.approx((0.0, k * (300.0 + SHEET_SPACING), 250.0, k * (300.0 + SHEET_SPACING) + 300.0))
+    assert [s.index for s in nest.sheets] == list(range(len(nest.sheets)))
+
+
+def test_a_piece_off_the_roll_is_refused(plates):
+    """The shapely check: a piece 1 mm past either edge of a 2000 mm roll, or before its start, is
+    refused; one on the edges is not."""
+    from patterns.nesting import _outline, _verify
+
+    bounds = [_outline(flat, 0.0).bounds for flat in plates.panels]
+    rest = [(0.0, 300.0 + 350.0 * k - b[0], -b[1]) for k, b in enumerate(bounds[1:])]  # 300 .. 1900 mm across
+    x0, y0, x1, _ = bounds[0]
+    for dx, dy, ok in ((-x0, -y0, True), (2000.0 - x1, -y0, True), (-x0 - 1.0, -y0, False),
+                       (2000.0 - x1 + 1.0, -y0, False), (-x0, -y0 - 1.0, False)):
+        laid = plates.placed([(0.0, dx, dy), *rest])
+        placed = [_outline(f, 0.0) for f in laid.panels]
+        args = ("plates", laid, placed, 2000.0, NestOptions(width=2000.0), [(0.0, 0.0, 2000.0, None)])
+        if ok:
+            _verify(*args)
+        else:
+            with pytest.raises(LayoutError, match=f"piece {laid.panels[0].name} lies off the roll or sheet"):
+                _verify(*args)
 
 
 def test_the_options_record_is_the_keywords(plates):

@@ -41,7 +41,7 @@ VENV = REPO / ".mutation-venv"
 
 MODULES = {  # the module mutated and the tests that answer for it (its unit tests and the quick stories)
     "patterns/measure.py": ["tests/test_measure.py", "tests/test_check.py"],
-    "patterns/audit.py": ["tests/test_check.py"],
+    "patterns/audit.py": ["tests/test_check.py", "tests/test_darts.py::test_the_report_and_the_dxf_list_every_dart"],
     "patterns/export/dxf.py": ["tests/test_dxf_pattern.py", "tests/test_export.py", "tests/test_garments.py"],
     "patterns/flattening/develop.py": ["tests/test_develop.py",
                                        "tests/test_sheet_metal.py::test_cone_frustum_blank_is_the_analytic_annular_sector",
