@@ -15,6 +15,7 @@ import shapely
 from .errors import InputError
 from .files import atomic_output
 from .measure import edge_strain, folded_faces, strain_stats
+from .model import Bookkeeping
 from .options import Options, option
 from .pattern import Pattern
 from .predicates import Overlap, boundary_crossings, crossing_segments, flat_polygon, overlap_verdict
@@ -201,9 +202,9 @@ class Report:
         The limits asked for.
     area_tolerance, max_distortion : float or None
         The limits of a usable pattern (:class:`CheckOptions`).
-    loading : patterns.Bookkeeping or None
+    loading : patterns.Bookkeeping
         What loading did to the input (vertices welded, pieces split, cuts
-        made, units converted).
+        made, units converted); nothing, for a report made by hand.
     """
 
     pattern: str
@@ -214,7 +215,7 @@ class Report:
     max_seam_mismatch: float | None = None
     area_tolerance: float | None = None
     max_distortion: float | None = None
-    loading: object = None
+    loading: Bookkeeping = Bookkeeping()
 
     @property
     def ok(self) -> bool:
@@ -236,7 +237,7 @@ class Report:
             "units": {"length": "mm", "area": "mm2", "strain": "ratio (0.01 = 1 %)"},
             "limits": {"max_strain": self.max_strain, "max_seam_mismatch": self.max_seam_mismatch,
                        "area_tolerance": self.area_tolerance, "max_distortion": self.max_distortion},
-            "loading": None if self.loading is None else {**asdict(self.loading), "said": str(self.loading)},
+            "loading": {**asdict(self.loading), "said": str(self.loading)},
             "panels": [{**asdict(p), "strain_max_at": list(p.strain_max_at),
                         "darts": [{"length_3d": d.length_3d, "legs_flat": list(d.legs_flat), "tip": list(d.tip)}
                                   for d in p.darts]} for p in self.panels],

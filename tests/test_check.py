@@ -184,6 +184,9 @@ def test_seam_mismatch_limit(cup):
     for f in found:
         (row,) = [s for s in report.seams if s.id == f.seam]
         assert f.panels == row.panels and abs(row.mismatch) > 0.001
+        assert f.message == (f"seam {row.id} ({row.panels[0]} / {row.panels[1]}): flat lengths "
+                             f"{row.length_flat[0]:.2f} and {row.length_flat[1]:.2f} mm differ by "
+                             f"{abs(row.mismatch):.2f} mm (limit 0.001 mm)")
     assert worst > 0.001
     assert patterns.check(free, max_seam_mismatch=10.0).ok
 
@@ -354,6 +357,9 @@ def test_outline_crossing_itself_is_a_finding():
     angle, radius = s_ / 600.0 * 2.4 * np.pi, 100.0 + t_  # bent round past a full turn: the ends cross
     bent = _with_uv(strip, 0, np.column_stack([radius * np.cos(angle), radius * np.sin(angle)]))
     assert Code.OUTLINE_CROSSES_ITSELF in _codes(bent) and Code.OUTLINE_CROSSES_ITSELF not in _codes(strip)
+    (found,) = [f for f in patterns.check(bent).findings if f.code is Code.OUTLINE_CROSSES_ITSELF]
+    assert found.message.startswith(f"panel {strip.panels[0].name}: its outline crosses itself at "
+                                    f"{len(found.points)} points (first: (")
 
 
 def test_a_mirrored_panel_is_inside_out(cup):
@@ -362,22 +368,28 @@ def test_a_mirrored_panel_is_inside_out(cup):
     assert Code.INSIDE_OUT in codes and Code.INSIDE_OUT not in _codes(cup)
 
 
-@pytest.mark.parametrize(("shift", "code"), [(1000.0, Code.HOLE_OUTSIDE_OUTLINE),
-                                             (None, Code.HOLE_CROSSES_OUTLINE)])
-def test_a_misplaced_hole_is_a_finding(holed, shift, code):
+@pytest.mark.parametrize(("how", "code", "words"), [
+    ("far", Code.HOLE_OUTSIDE_OUTLINE, "hole 1 lies outside the outline, near ("),
+    ("onto the edge", Code.HOLE_CROSSES_OUTLINE, "hole 1 crosses the outline at "),
+    ("twisted", Code.HOLE_CROSSES_OUTLINE, "hole 1 crosses itself at 1 points")])
+def test_a_misplaced_hole_is_a_finding(holed, how, code, words):
     pattern, i = holed
     flat = pattern.panels[i]
     uv = np.array(flat.uv)
     hole = flat.loops[1]
     centre = uv[hole].mean(axis=0)
-    if shift is None:  # the hole's centre onto the outline: it straddles the edge
+    if how == "onto the edge":  # the hole's centre onto the outline: it straddles the edge
         outline = uv[flat.loops[0]]
-        shift = outline[np.argmin(np.linalg.norm(outline - centre, axis=1))][0] - centre[0]
-        uv[hole] += [shift, outline[np.argmin(np.linalg.norm(outline - centre, axis=1))][1] - centre[1]]
-    else:
-        uv[hole] += [shift, 0.0]
-    assert code in _codes(_with_uv(pattern, i, uv))
+        uv[hole] += outline[np.argmin(np.linalg.norm(outline - centre, axis=1))] - centre
+    elif how == "far":
+        uv[hole] += [1000.0, 0.0]
+    else:  # two neighbours of the hole's ring swapped: the ring crosses itself once, between them
+        uv[hole[[3, 4]]] = uv[hole[[4, 3]]]
+    moved = _with_uv(pattern, i, uv)
+    assert code in _codes(moved)
     assert code not in _codes(pattern)
+    (found,) = [f for f in patterns.check(moved).findings if f.code is code]
+    assert found.message.startswith(f"panel {flat.name}: {words}")
 
 
 def test_a_panel_laid_at_the_wrong_size_is_not_usable(cup):
@@ -449,6 +461,29 @@ def test_a_collapsed_triangle_counts_as_folded_in_the_report():
     assert np.any(sa == 0.0)
     report = well_formed(patterns.check(collapsed), collapsed)
     assert report.panels[0].n_folded == int(np.count_nonzero(sa <= 0.0)) > 0
+
+
+def test_a_speck_laid_at_the_wrong_size_is_not_usable_either():
+    """The area rule holds at any size: a 1 x 0.5 mm piece laid at 0.9 of its size is 19 % short."""
+    from patterns.reading import mesh_model
+
+    st, f = surfaces.grid_mesh(3, 3)
+    speck = patterns.flatten(mesh_model(np.column_stack([st * [1.0, 0.5], np.zeros(len(st))]), f),
+                             method="isometric")
+    assert speck.panels[0].area == pytest.approx(0.5, rel=1e-9)
+    small = _with_uv(speck, 0, speck.panels[0].uv * 0.9)
+    (found,) = [f for f in patterns.check(small).findings if f.code is Code.AREA_NOT_KEPT]
+    assert "is 19.0% smaller than its 3D area 0.5 mm^2" in found.message
+    assert Code.AREA_NOT_KEPT not in _codes(speck)
+
+
+def test_a_report_made_by_hand_says_loading_did_nothing(cup):
+    """A Report built without its loading (a plugin's own): its dict says nothing was done."""
+    from patterns.audit import Report
+
+    made = Report(pattern="by hand", panels=(), seams=(), findings=())
+    assert made.to_dict()["loading"] == {"welded": 0, "unused": 0, "cuts": 0, "split": 0, "units": "mm",
+                                         "said": str(patterns.Bookkeeping())}
 
 
 def test_a_relaxation_stopped_early_is_a_note(cup):
