@@ -49,6 +49,10 @@ ROTATIONS = ("grain", "quarter", "free", "none")
 any multiple of 90, ``free`` any angle, ``none`` not at all."""
 
 _ANGLES = {"grain": [0.0, 180.0], "quarter": [0.0, 90.0, 180.0, 270.0], "free": None, "none": [0.0]}
+"""The turns sparrow may make, degrees (None: any)."""
+
+_TRIED = np.arange(0.0, 180.0, 1.0)
+"""The turns tried, degrees, when checking that a freely turning piece fits (its extents repeat every 180)."""
 
 SHEET_SPACING = 100.0
 """Between two sheets in the drawing, mm."""
@@ -166,14 +170,15 @@ class Layout:
     area_used : float
         ``width * length``, mm^2 (a nest on sheets: the sheets' area).
     area_panels : float
-        The pieces' cut area (with the margin), mm^2.
+        The area the pieces take: their outlines with the margin, holes counted in (nothing else is cut
+        there), mm^2.
     sheets : tuple of Sheet
         Sheet by sheet, for a nest on sheets; empty on a roll.
     seconds : float
         The search's time.
     """
 
-    pattern: object
+    pattern: object  # a patterns.Pattern (pattern.py imports this module for Pattern.layout)
     width: float
     length: float
     area_used: float
@@ -241,10 +246,10 @@ def layout(pattern, options: NestOptions | None = None, **keywords) -> Layout:
         _check_fits(pattern.name, flat.name, shape, across, along, opts.rotations)
     start = time.perf_counter()
     if opts.sheet is None:
-        placements = _solve(shapes, list(range(len(shapes))), across, opts)
+        placements = _solve(shapes, list(range(len(shapes))), across, opts, pattern.name)
         sheets, stock = (), [(0.0, 0.0, across, None)]
     else:
-        placements, sheets, stock = _fill_sheets(shapes, pieces, opts)
+        placements, sheets, stock = _fill_sheets(shapes, pieces, opts, pattern.name)
     seconds = time.perf_counter() - start
     laid = pieces.placed([placements[i] for i in range(len(shapes))])
     placed = [_outline(flat, opts.margin) for flat in laid.panels]
@@ -272,18 +277,15 @@ def _outline(flat, margin: float):
 def _item_points(shape) -> np.ndarray:
     """The outline offered to sparrow: grown and simplified within SIMPLIFY, in its frame (x along the
     strip = the piece's +Y, y across = its -X)."""
-    simple = shapely.simplify(shape.buffer(SIMPLIFY, join_style="mitre"), SIMPLIFY)
-    if simple.geom_type != "Polygon":
-        simple = max(getattr(simple, "geoms", [simple]), key=lambda g: g.area)
+    simple = shapely.simplify(shape.buffer(SIMPLIFY, join_style="mitre"), SIMPLIFY)  # a polygon: kept valid
     pts = np.asarray(simple.exterior.coords)[:-1]
     return np.column_stack([pts[:, 1], -pts[:, 0]])
 
 
 def _least_width(shape, rotations: str) -> float:
     """The least width (mm) the piece takes across the strip, over the turns allowed."""
-    angles = _ANGLES[rotations]
-    angles = np.arange(0.0, 180.0, 1.0) if angles is None else angles
-    return min(float(np.ptp(shapely.get_coordinates(affinity.rotate(shape, a, origin=(0, 0)))[:, 0])) for a in angles)
+    angles = _TRIED if _ANGLES[rotations] is None else _ANGLES[rotations]
+    return min(float(np.ptp(shapely.get_coordinates(affinity.rotate(shape, a))[:, 0])) for a in angles)
 
 
 def _check_fits(name, piece, shape, across, along, rotations):
@@ -298,26 +300,35 @@ def _check_fits(name, piece, shape, across, along, rotations):
 
 
 def _fits_sheet(shape, across, along, rotations) -> bool:
-    angles = _ANGLES[rotations]
-    for a in (np.arange(0.0, 180.0, 1.0) if angles is None else angles):
-        x0, y0, x1, y1 = affinity.rotate(shape, a, origin=(0, 0)).bounds
+    for a in _TRIED if _ANGLES[rotations] is None else _ANGLES[rotations]:
+        x0, y0, x1, y1 = affinity.rotate(shape, a).bounds
         if x1 - x0 <= across + 1e-9 and y1 - y0 <= along + 1e-9:
             return True
     return False
 
 
-def _solve(shapes, which, across, opts) -> dict:
+def _tolerance(across: float) -> float:
+    """How far (mm) a placed outline may stray past the stock's edges, or under the gap: a millionth of the
+    roll's width (sparrow computes in single precision)."""
+    return 1e-6 * max(float(across), 1.0)
+
+
+def _solve(shapes, which, across, opts, name) -> dict:
     """Sparrow on the pieces ``which``: ``{piece: (angle rad, dx, dy)}`` on a roll ``across`` wide."""
     points = [_item_points(shapes[i]) for i in which]
-    # sparrow keeps every item the separation away from the strip's edges too: a strip two gaps wider,
-    # and everything moved back by a gap, lets pieces touch the roll's edges (as a cutter may).
-    edge = float(opts.gap)
-    task = {"items": [np.round(p, 9).tolist() for p in points], "strip": float(across) + 2 * edge,
+    # sparrow keeps every item the separation away from the strip's edges too, and each item it sees is
+    # the outline grown by SIMPLIFY: a strip wider by both on either side, and everything moved back by
+    # them, lets the true outlines touch the roll's edges (as a cutter may) -- a piece as wide as the roll
+    # fits.
+    # And sparrow (single precision) needs a hair to spare: the strip is wider by _verify's tolerance,
+    # half of it either side.
+    edge, slack = float(opts.gap) + SIMPLIFY, _tolerance(across)
+    task = {"items": [np.round(p, 9).tolist() for p in points], "strip": float(across) + 2 * edge + slack,
             "orientations": _ANGLES[opts.rotations], "gap": float(opts.gap), "time": int(opts.time_limit),
             "seed": int(opts.seed)}
     placed = _remembered(task) if opts.cache else None
     if placed is None:
-        placed = _sparrow(task)
+        placed = _sparrow(task, name)
         if opts.cache:
             _remember(task, placed)
     out = {}
@@ -325,12 +336,13 @@ def _solve(shapes, which, across, opts) -> dict:
         theta = np.radians(rotation) % (2 * np.pi)  # in [0, 2 pi): sparrow says -180 for 180
         # sparrow's frame (x along, y across) is the piece's turned by -90 degrees; ours is sparrow's
         # turned back by +90 and moved across by the roll's width: a turn of theta, then a move.
-        out[which[k]] = (float(theta), float(across + edge - ty), float(tx - edge))
+        out[which[k]] = (float(theta), float(across + edge + slack / 2 - ty), float(tx - edge))
     return out
 
 
-def _sparrow(task: dict) -> list:
-    """``[(rotation deg, tx, ty)]`` per item: sparrow's answer to ``task``."""
+def _sparrow(task: dict, name: str) -> list:
+    """``[(rotation deg, tx, ty)]`` per item: sparrow's answer to ``task``; LayoutError (naming ``name``) when
+    sparrow gives up."""
     import spyrrow
 
     items = [spyrrow.Item(str(k), [tuple(p) for p in pts], demand=1, allowed_orientations=task["orientations"])
@@ -339,8 +351,14 @@ def _sparrow(task: dict) -> list:
     config = spyrrow.StripPackingConfig(early_termination=True, total_computation_time=task["time"],
                                         min_items_separation=task["gap"] if task["gap"] > 0 else None,
                                         seed=task["seed"], num_workers=1)
+    try:
+        solution = instance.solve(config)
+    except BaseException as exc:  # a panic in sparrow reaches Python as pyo3's PanicException, a BaseException
+        if isinstance(exc, (KeyboardInterrupt, SystemExit)):
+            raise
+        raise LayoutError(f"{name}: sparrow could not nest the pieces ({exc})") from None
     placed = [None] * len(items)
-    for item in instance.solve(config).placed_items:
+    for item in solution.placed_items:
         placed[int(item.id)] = (float(item.rotation), *map(float, item.translation))
     return placed
 
@@ -384,7 +402,7 @@ def _ends(shapes, found) -> dict:
             for i, (angle, dx, dy) in found.items()}
 
 
-def _fill_sheets(shapes, pieces, opts):
+def _fill_sheets(shapes, pieces, opts, name):
     """Sheet after sheet: the pieces nested on a strip as wide as a sheet, those lying wholly within the
     sheet's length kept on it; then each piece left over, largest first, tried on that sheet too (a short
     search of the sheet's pieces and it, kept if all fit), until the sheet's time is spent; the rest go on
@@ -395,18 +413,18 @@ def _fill_sheets(shapes, pieces, opts):
     trial = replace(opts, time_limit=max(1, opts.time_limit // 5))
     while left:
         start = time.monotonic()
-        found = _solve(shapes, left, width, opts)
+        found = _solve(shapes, left, width, opts, name)
         ends = _ends(shapes, found)
         on_sheet = [i for i in left if ends[i] <= length + 1e-9]
         if not on_sheet:  # the nearest piece alone, from the start of the sheet
             i = min(left, key=lambda j: found[j][2])
-            found = _solve(shapes, [i], width, trial)
+            found = _solve(shapes, [i], width, trial, name)
             on_sheet = [i]
         found = {i: found[i] for i in on_sheet}
         for i in sorted((j for j in left if j not in on_sheet), key=lambda j: -shapes[j].area):
             if time.monotonic() - start > 2 * opts.time_limit:
                 break
-            attempt = _solve(shapes, on_sheet + [i], width, trial)
+            attempt = _solve(shapes, on_sheet + [i], width, trial, name)
             if max(_ends(shapes, attempt).values()) <= length + 1e-9:
                 on_sheet.append(i)
                 found = attempt
@@ -423,7 +441,7 @@ def _fill_sheets(shapes, pieces, opts):
 
 def _verify(name, laid, placed, across, opts, stock) -> None:
     """Raise LayoutError unless every gap holds, no two pieces overlap, and all lie on the stock."""
-    tol = 1e-6 * max(across, 1.0)
+    tol = _tolerance(across)
     tree = shapely.STRtree(placed)
     left, right = tree.query(placed, predicate="dwithin", distance=max(opts.gap - tol, 0.0))
     for a, b in zip(left, right):

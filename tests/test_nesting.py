@@ -101,6 +101,7 @@ def test_the_margin_is_kept_around_each_outline():
     assert _min_distance(polys) >= 20.0 - 1e-6
     x = np.concatenate([np.asarray(p.exterior.coords)[:, 0] for p in polys])
     assert x.min() >= 5.0 - 1e-6 and x.max() <= 400.0 - 5.0 + 1e-6
+    assert nest.area_panels == pytest.approx(3 * 110.0 * 60.0, rel=1e-9)  # each outline with its 5 mm all round
 
 
 @pytest.mark.parametrize(("kwargs", "words"), [
@@ -327,6 +328,56 @@ def test_a_piece_off_the_roll_is_refused(plates):
         else:
             with pytest.raises(LayoutError, match=f"piece {laid.panels[0].name} lies off the roll or sheet"):
                 _verify(*args)
+
+
+@pytest.mark.parametrize("gap", [10.0, 0.0])
+def test_a_piece_as_wide_as_the_roll_fits(gap):
+    """Two 100 x 50 mm pieces on a 100 mm roll, not turned: one after the other, each touching both
+    edges (sparrow sees every outline 0.05 mm larger, and wants room to spare: the strip it is given
+    allows for both, the pieces land on the true roll)."""
+    nest = _rectangles([(100.0, 50.0)] * 2).layout(width=100.0, gap=gap, rotations="none", **QUICK)
+    for poly in _outlines(nest.pattern):
+        x0, _, x1, _ = poly.bounds
+        assert x0 == pytest.approx(0.0, abs=1e-4) and x1 == pytest.approx(100.0, abs=1e-4)
+    assert nest.length == pytest.approx(100.0 + gap, abs=0.2)
+
+
+def test_sparrow_giving_up_is_a_layout_error():
+    """A panic inside sparrow (here: an item wider than its strip, which layout() never sends) reaches
+    the caller as a LayoutError naming the pattern, not as pyo3's PanicException."""
+    from patterns.nesting import _sparrow
+
+    task = {"items": [[[0.0, 0.0], [50.0, 0.0], [50.0, 200.0], [0.0, 200.0]]], "strip": 100.0,
+            "orientations": [0.0], "gap": 0.0, "time": 1, "seed": 0}
+    with pytest.raises(LayoutError, match=r"^wide: sparrow could not nest the pieces \("):
+        _sparrow(task, "wide")
+
+
+def test_a_piece_too_wide_for_a_sheet_says_sheet():
+    with pytest.raises(LayoutError, match=r"piece .* is 300.0 mm wide, wider than the 400 x 100 mm sheet in every"):
+        _rectangles([(300.0, 200.0)]).layout(sheet=(400.0, 100.0), **QUICK)
+
+
+@pytest.mark.parametrize(("size", "sheet"), [((300.0, 40.0), (300.5, 40.5)), ((40.0, 300.0), (300.5, 40.5))])
+def test_a_freely_turning_piece_fits_where_only_one_turn_does(size, sheet):
+    """A 300 x 40 mm piece on a sheet it fits only lying one way (turned by 90 degrees, or not at all):
+    with rotations="free" it is nested, lying that way."""
+    nest = _rectangles([size]).layout(sheet=sheet, rotations="free", **QUICK)
+    x0, y0, x1, y1 = _outlines(nest.pattern)[0].bounds
+    assert (x1 - x0, y1 - y0) == pytest.approx((40.0, 300.0), abs=1e-3)
+
+
+def test_the_ends_along_the_strip_are_the_placed_outlines():
+    """_ends (which pieces lie within a sheet's length) places each outline as Pattern.placed does: a turn
+    about the panel's own origin, then the move."""
+    from patterns.nesting import _ends, _outline
+
+    pattern = _rectangles([(120.0, 30.0), (80.0, 60.0), (50.0, 50.0)])
+    moves = {0: (np.pi / 2, 300.0, 40.0), 1: (np.pi, 100.0, 500.0), 2: (0.3, -20.0, 7.0)}
+    laid = pattern.placed([moves[i] for i in range(3)])
+    ends = _ends([_outline(flat, 0.0) for flat in pattern.panels], moves)
+    for i, flat in enumerate(laid.panels):
+        assert ends[i] == pytest.approx(flat.uv[:, 1].max(), abs=1e-9)
 
 
 def test_the_options_record_is_the_keywords(plates):
