@@ -192,6 +192,9 @@ def test_astm_profile_is_piece_blocks_for_garment_cad(cup, tmp_path):
         assert ring_numbers(sew_pts) == pytest.approx(ring_numbers(flat.uv[flat.loops[0]]), rel=1e-6)
         piece = {t.dxf.text for t in block.query("TEXT") if t.dxf.layer == "1"}
         assert {f"Piece Name:{flat.name}", "Quantity:1", "Material:", "Units:METRIC"} <= piece
+        panel = patterns.check(cup).panels[cup.panels.index(flat)]  # the report's numbers, as on the machine profile
+        assert f"STRAIN RMS {100 * panel.strain_rms:.2f}% MAX {100 * panel.strain_max:.2f}%" in {
+            t.dxf.text for t in block.query("TEXT")}
         notches = [e for e in block.query("POINT") if e.dxf.layer == "4"]
         assert len(notches) == 4  # two seams, two ends each
         for n in notches:
@@ -663,13 +666,7 @@ def test_squared_corners_at_a_corner_just_past_thirty_degrees(tmp_path):
     """A prism on a convex pentagon whose corners turn by 30.5, 75, 85, 90 and 79.5 degrees: with
     ``seam_corners="square"`` each of its faces' cut lines, read back, is the squared outline built
     from the definition (every corner over 30 degrees squared, the 30.5 degree one too)."""
-    turns = np.radians([30.5, 75, 85, 90, 79.5])
-    heading = np.cumsum(np.r_[0, turns[:-1]])
-    d = np.column_stack([np.cos(heading), np.sin(heading)])
-    first = np.array([120.0, 80.0, 60.0])  # the last two sides close the pentagon
-    sides = np.r_[first, np.linalg.solve(d[3:].T, -(first[:, None] * d[:3]).sum(axis=0))]
-    corners = np.vstack([[0, 0], np.cumsum(sides[:, None] * d, axis=0)[:-1]])
-    prism = bd.extrude(bd.Polygon(*[tuple(c) for c in corners], align=None), 30)
+    prism = _pentagon_prism([30.5, 75, 85, 90, 79.5])
     flat = patterns.flatten(patterns.load(prism, max_edge=10))
     pattern = flat.placed([(0.0, 400.0 * k, 0.0) for k in range(len(flat.panels))])
     path = tmp_path / "prism.dxf"
@@ -688,6 +685,54 @@ def test_squared_corners_at_a_corner_just_past_thirty_degrees(tmp_path):
         assert cut.symmetric_difference(expected).area < 1e-6 * expected.area
         checked += len(loop) == 5
     assert checked == 2  # the two pentagons, and the five rectangles
+
+
+def _pentagon_prism(turns_deg):
+    """A prism 30 mm tall on a convex pentagon whose corners turn by ``turns_deg`` (summing to 360),
+    its first three sides 120, 80 and 60 mm (the last two close it)."""
+    turns = np.radians(turns_deg)
+    heading = np.cumsum(np.r_[0, turns[:-1]])
+    d = np.column_stack([np.cos(heading), np.sin(heading)])
+    first = np.array([120.0, 80.0, 60.0])
+    sides = np.r_[first, np.linalg.solve(d[3:].T, -(first[:, None] * d[:3]).sum(axis=0))]
+    corners = np.vstack([[0, 0], np.cumsum(sides[:, None] * d, axis=0)[:-1]])
+    return bd.extrude(bd.Polygon(*[tuple(c) for c in corners], align=None), 30)
+
+
+def test_astm_turn_points_are_the_corners_past_twenty_degrees(tmp_path):
+    """ASTM layer 2 (turn points) holds the outline's corners, layer 3 (curve points) the rest: on a
+    pentagon whose corners turn by 20.5 to 90 degrees every corner is a turn point, the 20.5 one too;
+    a hole's cut loop is closed, on layer 11."""
+    flat = patterns.flatten(patterns.load(_pentagon_prism([20.5, 75, 85, 90, 89.5]), max_edge=10))
+    path = tmp_path / "prism.dxf"
+    flat.to_dxf(path, profile="astm")
+    doc = read(path)
+    pentagons = 0
+    for insert in doc.modelspace().query("INSERT"):
+        block = doc.blocks[insert.dxf.name]
+        (cut,) = [e for e in block.query("POLYLINE") if e.dxf.layer == "1"]
+        ring = np.array([tuple(v.dxf.location)[:2] for v in cut.vertices])
+        turns = [np.array(tuple(e.dxf.location)[:2]) for e in block.query('POINT[layer=="2"]')]
+        assert len(turns) == len(ring)  # its straight runs are one segment: every vertex a corner
+        pentagons += len(ring) == 5
+    assert pentagons == 2
+    plate = patterns.flatten(patterns.load(bd.Box(200, 100, 50) - bd.Cylinder(20, 50), max_edge=10))
+    plate.to_dxf(path, profile="astm", seam_allowance=5.0)
+    doc = read(path)
+    holes = [e for insert in doc.modelspace().query("INSERT") for e in doc.blocks[insert.dxf.name].query("POLYLINE")
+             if e.dxf.layer == "11"]
+    assert len(holes) == 2 and all(h.is_closed for h in holes)
+
+
+def test_a_notch_a_hair_before_the_end_is_left_out(notched, tmp_path):
+    """notch_spacing 49 on the box: a notch every 49 mm of each seam and at its end, but none closer
+    than a quarter of the spacing before the end one -- 200 mm: 0, 49, 98, 147, 200 (not 196);
+    100 mm: 0, 49, 100 (not 98); 50 mm: 0, 50 (not 49) -- on both sides of every seam."""
+    pattern = notched["box"]
+    path = tmp_path / "box.dxf"
+    pattern.to_dxf(path, notch_spacing=49.0)
+    expected = {200.0: 5, 100.0: 3, 50.0: 2}
+    assert len(_notch_lines(read(path))) == sum(2 * expected[round(fs.length)] for fs in pattern.seams)
 
 
 def test_an_allowance_grows_the_outline_and_shrinks_the_hole(plate, tmp_path):

@@ -197,6 +197,14 @@ def test_bend_lines_on_the_bend_layer(hopper, tmp_path):
     assert len(doc.modelspace().query('LINE[layer=="BEND"]')) == 30
     texts = [t.dxf.text for t in doc.modelspace().query('TEXT[layer=="BEND"]')]
     assert texts and all(t == f"BEND {turn:.2f} DEG" for t in texts)
+    # each label centred on a bend line, along it, not at its ends
+    segments = [(np.array(e.dxf.start)[:2], np.array(e.dxf.end)[:2]) for e in doc.modelspace().query('LINE[layer=="BEND"]')]
+    for t in doc.modelspace().query('TEXT[layer=="BEND"]'):
+        at = np.array(t.dxf.align_point)[:2]
+        a, b = min(segments, key=lambda ab: shapely.LineString(ab).distance(shapely.Point(at)))
+        along = (at - a) @ (b - a) / ((b - a) @ (b - a))
+        assert shapely.LineString([a, b]).distance(shapely.Point(at)) < 1e-6 and 0.05 < along < 0.95
+        assert abs(abs(np.cos(np.radians(t.dxf.rotation) - np.arctan2(*(b - a)[::-1])))) == pytest.approx(1.0)
     cylinder = patterns.flatten(patterns.load(SAMPLES / "rolled_cylinder.step")).panels[0]
     rulings = cylinder.rulings(100.0)
     # Along the axis (its flat direction is averaged over the chord triangles: 2e-5 mm off over 500).

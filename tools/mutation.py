@@ -42,7 +42,8 @@ VENV = REPO / ".mutation-venv"
 MODULES = {  # the module mutated and the tests that answer for it (its unit tests and the quick stories)
     "patterns/measure.py": ["tests/test_measure.py", "tests/test_check.py"],
     "patterns/audit.py": ["tests/test_check.py", "tests/test_darts.py::test_the_report_and_the_dxf_list_every_dart"],
-    "patterns/export/dxf.py": ["tests/test_dxf_pattern.py", "tests/test_export.py", "tests/test_garments.py"],
+    "patterns/export/dxf.py": ["tests/test_dxf_pattern.py", "tests/test_export.py", "tests/test_garments.py",
+                               "tests/test_sheet_metal.py::test_bend_lines_on_the_bend_layer"],
     "patterns/flattening/develop.py": ["tests/test_develop.py",
                                        "tests/test_sheet_metal.py::test_cone_frustum_blank_is_the_analytic_annular_sector",
                                        "tests/test_sheet_metal.py::test_rolled_cylinder_blank_length_with_thickness_and_k_factor",
@@ -71,14 +72,15 @@ def _chosen(name: str, only) -> bool:
 
 
 def run(module: str, tests: list, python: Path, *, only=(), max_children=None, sample=None, seed=0,
-        timeout_multiplier: float = 15.0) -> dict:
+        timeout_multiplier: float = 15.0, show_killed: bool = False) -> dict:
     """Run mutmut on one module in a copy of the repository: ``{"killed", "survived", "timeout", "survivors"}``.
 
     ``only``: mutant-name patterns (``patterns.export.dxf.x__notches__mutmut_*``) to run instead of
     every mutant of the module; ``max_children``: at most this many test processes at once;
     ``sample``: run a uniform random sample of this many of the mutants (``seed`` picks it) -- for a
     module whose tests are slow, an estimate of the score with its interval; ``timeout_multiplier``:
-    mutmut's (a mutant is stopped, and counted killed, past ``2 x multiplier x`` its tests' CPU time).
+    mutmut's (a mutant is stopped, and counted killed, past ``2 x multiplier x`` its tests' CPU time);
+    ``show_killed``: keep the diffs of the killed mutants too (to check a kill by hand).
     The slow tests are left out."""
     with tempfile.TemporaryDirectory(prefix="patterns-mutation-") as tmp:
         work = Path(tmp) / "repo"
@@ -108,9 +110,10 @@ def run(module: str, tests: list, python: Path, *, only=(), max_children=None, s
         done = subprocess.run([*mutmut, "run", *children, *only], cwd=work, capture_output=True, text=True)
         listing = subprocess.run([*mutmut, "results", "--all", "true"], cwd=work, capture_output=True,
                                  text=True).stdout
+        shown = ("survived", "killed", "timeout") if show_killed else ("survived",)
         diffs = {name: subprocess.run([*mutmut, "show", name], cwd=work, capture_output=True, text=True).stdout
                  for name, state in re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M)
-                 if state.strip() == "survived" and _chosen(name, only)}
+                 if state.strip() in shown and _chosen(name, only)}
     status = [(n, st) for n, st in re.findall(r"^\s*(\S+): (.+)$", listing, flags=re.M) if _chosen(n, only)]
     if not status or all(state.strip() not in ("killed", "survived", "timeout") for _, state in status):
         # mutmut stopped before mutating (its clean run of the tests failed, say): show why
@@ -121,6 +124,8 @@ def run(module: str, tests: list, python: Path, *, only=(), max_children=None, s
         out[key] += 1
         if key == "survived":
             out["survivors"].append(name)
+        elif key in ("killed", "timeout"):
+            out.setdefault("kills", []).append(name)
     return out
 
 
@@ -135,6 +140,8 @@ def main(argv=None) -> int:
     parser.add_argument("--sample", type=int, default=None, metavar="N",
                         help="run a uniform random sample of N mutants (an estimate, with its 95 %% interval)")
     parser.add_argument("--seed", type=int, default=0, help="the sample's seed")
+    parser.add_argument("--show-killed", action="store_true",
+                        help="print the killed mutants' diffs too (stderr), to check kills by hand")
     parser.add_argument("--timeout-multiplier", type=float, default=15.0,
                         help="mutmut's: a mutant past 2 x this x its tests' CPU time is stopped (killed)")
     args = parser.parse_args(argv)
@@ -146,7 +153,7 @@ def main(argv=None) -> int:
     for module in args.modules:
         tests = args.tests or MODULES.get(module, ["tests/"])
         r = run(module, tests, python, only=args.only, max_children=args.max_children, sample=args.sample,
-                seed=args.seed, timeout_multiplier=args.timeout_multiplier)
+                seed=args.seed, timeout_multiplier=args.timeout_multiplier, show_killed=args.show_killed)
         killed = r["killed"] + r["timeout"]
         total_k, total_s, total_t = total_k + killed, total_s + r["survived"], total_t + r["timeout"]
         n = max(killed + r["survived"], 1)
@@ -161,6 +168,8 @@ def main(argv=None) -> int:
         print(rows[-1], flush=True)
         for name in r["survivors"]:
             print(f"survived: {name}\n{r['diffs'].get(name, '')}", file=sys.stderr, flush=True)
+        for name in r.get("kills", []) if args.show_killed else ():
+            print(f"killed: {name}\n{r['diffs'].get(name, '')}", file=sys.stderr, flush=True)
     print(f"| all | {total_k + total_s} | {total_k - total_t} | {total_t} | {total_s} | "
           f"{total_k / max(total_k + total_s, 1):.1%} | {(total_k - total_t) / max(total_k - total_t + total_s, 1):.1%} |")
     return 0
