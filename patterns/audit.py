@@ -348,11 +348,11 @@ def _usable(flat, report, opts) -> list:
     its flat area off its 3D area (``area_tolerance``), or more than :data:`GROSS_SHARE` of its area
     laid flat at more than ``max_distortion`` times its size, or a fraction of it, in some direction."""
     out = []
-    name, none = flat.name, np.zeros(0, dtype=np.int64)
+    name = flat.name
     change = report.area_flat / report.area_3d - 1.0 if report.area_3d > 0 else 0.0
     at = np.array([report.strain_max_at])
     if opts.area_tolerance is not None and abs(change) > opts.area_tolerance:
-        out.append(Finding(Code.AREA_NOT_KEPT, Severity.ERROR, (name,), at, none, None,
+        out.append(Finding(Code.AREA_NOT_KEPT, Severity.ERROR, (name,), at, (), None,
                            f"panel {name}: flat area {report.area_flat:.1f} mm^2 is {abs(change):.1%} "
                            f"{'smaller' if change < 0 else 'larger'} than its 3D area {report.area_3d:.1f} mm^2 "
                            f"(tolerance {opts.area_tolerance:.1%}): not a usable pattern of this surface; give it "
@@ -401,15 +401,14 @@ def _panel_report(flat, max_strain):
                 f"({len(above)} triangles), up to {mag[worst]:.2%} at ({centre[0]:.1f}, {centre[1]:.1f}) mm"))
     findings += _panel_overlaps(flat)
     res = flat.flattening
-    none = np.zeros(0, dtype=np.int64)
     if flat.darts:
         tips = np.array([uv[d.tip] for d in flat.darts])
         length = sum(d.length_3d for d in flat.darts)
-        findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), tips, none,
+        findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), tips, (),
                                 None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
                                       f"the limit ({length:.1f} mm of cuts; points: their tips)"))
     if not res.converged:
-        findings.append(Finding(Code.NOT_CONVERGED, Severity.NOTE, (flat.name,), np.zeros((0, 2)), none, None,
+        findings.append(Finding(Code.NOT_CONVERGED, Severity.NOTE, (flat.name,), np.zeros((0, 2)), (), None,
                                 f"panel {flat.name}: the relaxation stopped after {res.iterations} iterations "
                                 f"before converging"))
     at = uv[faces[stats.worst]].mean(axis=0)
@@ -430,7 +429,6 @@ def _seam_report(pattern, fs, max_seam_mismatch):
     """``(SeamReport, findings)`` of one flat seam."""
     seam = fs.seam
     names = tuple(pattern.panels[p].name for p in seam.panels)
-    none = np.zeros(0, dtype=np.int64)
     pct = 100.0 * fs.mismatch / seam.length if seam.length > 0 else 0.0
     held = None if fs.held_lengths is None else tuple(float(x) for x in fs.held_lengths)
     report = SeamReport(seam.id, names, seam.cad_edge, float(seam.length), seam.polyline_length,
@@ -439,7 +437,7 @@ def _seam_report(pattern, fs, max_seam_mismatch):
     mid = pattern.panels[seam.panels[0]].uv[seam.vertices[0][len(seam.vertices[0]) // 2]]
     if max_seam_mismatch is not None and abs(fs.mismatch) > max_seam_mismatch:
         findings.append(Finding(
-            Code.SEAM_MISMATCH_ABOVE_LIMIT, Severity.LIMIT, names, mid[None, :], none,
+            Code.SEAM_MISMATCH_ABOVE_LIMIT, Severity.LIMIT, names, mid[None, :], (),
             seam.id, f"seam {seam.id} ({names[0]} / {names[1]}): flat lengths {fs.flat_lengths[0]:.2f} and "
                      f"{fs.flat_lengths[1]:.2f} mm differ by {abs(fs.mismatch):.2f} mm "
                      f"(limit {max_seam_mismatch:g} mm)"))
@@ -449,7 +447,7 @@ def _seam_report(pattern, fs, max_seam_mismatch):
         if off:
             side, got, want = max(off, key=lambda x: abs(x[1] / x[2] - 1.0))
             findings.append(Finding(
-                Code.SEAM_LENGTH_NOT_KEPT, Severity.LIMIT, names, mid[None, :], none, seam.id,
+                Code.SEAM_LENGTH_NOT_KEPT, Severity.LIMIT, names, mid[None, :], (), seam.id,
                 f"seam {seam.id} ({names[0]} / {names[1]}): could not be held at its length "
                 f"(folds in the way, or the relaxation stopped early): "
                 f"{got:.2f} mm flat on {names[side]}'s side, {want:.2f} mm wanted ({100 * (got / want - 1):+.2f} %)"))
@@ -461,7 +459,6 @@ def _panel_overlaps(flat) -> list:
     uv, faces, loops, name = flat.uv, flat.faces, flat.loops, flat.name
     out = []
     folded = folded_faces(uv, faces)
-    none = np.zeros(0, dtype=np.int64)
     if len(folded):
         centres = uv[faces[folded]].mean(axis=1)
         c = centres[0]
@@ -473,19 +470,19 @@ def _panel_overlaps(flat) -> list:
         what = ("its outline crosses itself" if a == b == 0 else
                 f"hole {b} crosses the outline" if a == 0 else
                 f"hole {a} crosses itself" if a == b else f"holes {a} and {b} cross")
-        out.append(Finding(code, Severity.ERROR, (name,), pts, none, None,
+        out.append(Finding(code, Severity.ERROR, (name,), pts, (), None,
                            f"panel {name}: {what} at {len(pts)} points (first: ({pts[0, 0]:.1f}, {pts[0, 1]:.1f}) mm)"))
     rings = [shapely.linearrings(uv[loop]) for loop in loops]
     if not shapely.is_ccw(rings[0]):
         c = uv[loops[0]].mean(axis=0)
-        out.append(Finding(Code.INSIDE_OUT, Severity.ERROR, (name,), c[None, :], none, None,
+        out.append(Finding(Code.INSIDE_OUT, Severity.ERROR, (name,), c[None, :], (), None,
                            f"panel {name}: the flat outline runs clockwise (the panel is turned inside out)"))
     outer = flat_polygon(uv, loops, holes=False)
     for k in range(1, len(loops)):
         inside = shapely.contains_xy(outer, uv[loops[k], 0], uv[loops[k], 1])
         if not inside.any():
             p = uv[loops[k]][0]
-            out.append(Finding(Code.HOLE_OUTSIDE_OUTLINE, Severity.ERROR, (name,), p[None, :], none, None,
+            out.append(Finding(Code.HOLE_OUTSIDE_OUTLINE, Severity.ERROR, (name,), p[None, :], (), None,
                                f"panel {name}: hole {k} lies outside the outline, near ({p[0]:.1f}, {p[1]:.1f}) mm"))
     return out
 
@@ -502,7 +499,6 @@ def _overlaps_between(pattern) -> list:
     i, j = shapely.STRtree(polys).query(polys, predicate="intersects")
     keep = i < j
     out = []
-    none = np.zeros(0, dtype=np.int64)
     for a, b in zip(i[keep], j[keep]):
         common = shapely.intersection(polys[a], polys[b])
         area = shapely.area(common)
@@ -511,6 +507,6 @@ def _overlaps_between(pattern) -> list:
             continue  # touching along an edge or at a point
         p = shapely.get_coordinates(shapely.point_on_surface(common))[0]
         na, nb = pattern.panels[a].name, pattern.panels[b].name
-        out.append(Finding(Code.PANELS_OVERLAP, Severity.ERROR, (na, nb), p[None, :], none, None,
+        out.append(Finding(Code.PANELS_OVERLAP, Severity.ERROR, (na, nb), p[None, :], (), None,
                            f"panels {na} and {nb} overlap by {area:.1f} mm^2 around ({p[0]:.1f}, {p[1]:.1f}) mm"))
     return out

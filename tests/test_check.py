@@ -486,6 +486,42 @@ def test_a_report_made_by_hand_says_loading_did_nothing(cup):
                                          "said": str(patterns.Bookkeeping())}
 
 
+def test_an_options_record_is_honoured_and_findings_come_errors_first(cup):
+    """check(pattern, CheckOptions(...)) judges by the record, as check(pattern, **keywords) does; the
+    findings come errors first, then exceeded limits, then notes."""
+    from patterns.audit import CheckOptions
+
+    squeezed = _with_uv(cup, 0, cup.panels[0].uv * [1.0, 0.4])  # an error (area), limits (strain)
+    short = patterns.flatten(cup.model, max_iterations=2)  # notes (not converged)
+    from dataclasses import replace
+
+    mixed = replace(squeezed, panels=squeezed.panels[:1] + short.panels[1:])
+    by_record = patterns.check(mixed, CheckOptions(max_strain=0.001))
+    by_keyword = patterns.check(mixed, max_strain=0.001)
+    assert [f.message for f in by_record.findings] == [f.message for f in by_keyword.findings]
+    assert by_record.max_strain == 0.001 and patterns.check(mixed).max_strain != 0.001
+    severities = [f.severity for f in by_record.findings]
+    assert {Severity.ERROR, Severity.LIMIT, Severity.NOTE} <= set(severities)
+    rank = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
+    assert [rank[x] for x in severities] == sorted(rank[x] for x in severities)
+
+
+def test_a_seam_finding_is_placed_at_the_seam_s_middle(cup):
+    """A seam's finding points at the middle of the seam as laid flat (on its first panel): on the flat
+    polyline, half way along it (within one segment)."""
+    free = patterns.flatten(cup.model, seams="free")
+    report = patterns.check(free, max_seam_mismatch=0.001)
+    found = [f for f in report.findings if f.code is Code.SEAM_MISMATCH_ABOVE_LIMIT]
+    assert found
+    for f in found:
+        (fs,) = [fs for fs in free.seams if fs.seam.id == f.seam]
+        line = shapely.LineString(free.panels[fs.seam.panels[0]].uv[fs.seam.vertices[0]])
+        at = shapely.Point(f.points[0])
+        assert line.distance(at) < 1e-9
+        step = max(np.linalg.norm(np.diff(np.asarray(line.coords), axis=0), axis=1))
+        assert abs(line.project(at) - line.length / 2) <= step
+
+
 def test_a_relaxation_stopped_early_is_a_note(cup):
     short = patterns.flatten(cup.model, max_iterations=2)
     found = [f for f in patterns.check(short).findings if f.code is Code.NOT_CONVERGED]
