@@ -42,13 +42,15 @@ class Flattening:
         Boundary loops (vertex indices, surface to their left; longest first).
     method : str
     seed_face : int
-        The triangle the greedy grower laid down first, without distortion.
+        The triangle the greedy grower laid down first, without distortion;
+        -1 for an exact development (no grower).
     overlap : Overlap
         The overlap verdict: folded triangles, loop tests, ``one_to_one``.
     start : str
         ``"relaxed"`` only: the layout the relaxation started from --
         ``"greedy"`` (the isometric grower's, when it is one-to-one), else
-        ``"lscm"`` (when that is one-to-one), else ``"tutte"``; "" otherwise.
+        ``"lscm"`` (when that is one-to-one), else ``"tutte"``; ``"exact"``:
+        ``"analytic"``; "" otherwise.
     iterations : int
         ``"relaxed"`` only: relaxation iterations run (0 otherwise).
     converged : bool

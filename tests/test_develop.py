@@ -1,11 +1,16 @@
 """patterns.flattening.develop: exact developments of planes, cylinders and cones against their
 analytic formulas, and the neutral surface of a sheet."""
 
+import re
+
 import numpy as np
 import pytest
 
+import patterns
+
 from patterns.errors import InputError
 from patterns.flattening.develop import develop, neutral_offset, offset_points
+from patterns.measure import signed_areas
 from patterns.model import Surface, SurfaceKind
 
 X, Y, Z = np.eye(3)
@@ -60,11 +65,30 @@ def test_the_neutral_surface_lies_k_t_from_the_inside_skin(reference, expected):
     assert neutral_offset(2.0, 0.44, reference) == pytest.approx(expected, abs=1e-12)
 
 
-@pytest.mark.parametrize("kwargs", [{"thickness": -1.0}, {"k_factor": 1.5}, {"reference": "middle"}])
-def test_bad_sheet_options_are_refused(kwargs):
+@pytest.mark.parametrize(("kwargs", "words"), [
+    ({"thickness": -1.0}, "thickness (mm) must be a number >= 0, got -1.0"),
+    ({"k_factor": 1.5}, "k_factor must be a number between 0 and 1, got 1.5"),
+    ({"reference": "middle"}, "reference must be one of inside, outside, mid, got 'middle'")])
+def test_bad_sheet_options_are_refused(kwargs, words):
+    """One line naming the part (``name``, default "pattern") and what is wrong."""
     args = {"thickness": 2.0, "k_factor": 0.5, "reference": "mid", **kwargs}
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="^" + re.escape(f"bracket: {words}") + "$"):
+        neutral_offset(args["thickness"], args["k_factor"], args["reference"], name="bracket")
+    with pytest.raises(InputError, match="^" + re.escape(f"pattern: {words}") + "$"):
         neutral_offset(args["thickness"], args["k_factor"], args["reference"])
+
+
+def test_an_exact_development_says_so_and_runs_counter_clockwise_at_any_size():
+    """Every face of a 1 x 0.5 x 0.2 mm box (0.1 to 0.5 mm^2) is developed exactly: method "exact",
+    no grower's seed (-1), started from the analytic development, every triangle counter-clockwise."""
+    import build123d as bd
+
+    pattern = patterns.flatten(patterns.load(bd.Box(1, 0.5, 0.2)))
+    assert sorted(round(f.area, 9) for f in pattern.panels) == [0.1, 0.1, 0.2, 0.2, 0.5, 0.5]
+    for flat in pattern.panels:
+        result = flat.flattening
+        assert (result.method, result.seed_face, result.start) == ("exact", -1, "analytic")
+        assert np.all(signed_areas(flat.uv, flat.faces) > 0)
 
 
 def test_offsetting_a_cylinder_moves_points_radially():
@@ -111,14 +135,18 @@ def test_a_general_cone_unrolls_by_its_directrix(apex, samples, tol):
         r = ring / np.linalg.norm(ring, axis=1)[:, None]
         within = np.arccos(np.clip((r * d[k]).sum(axis=1), -1, 1))
         expect_s, expect_angle = np.linalg.norm(pts - apex, axis=1), theta[k] + within
+        # and on the directrix's own lines, its first and last included: the angle turned so far
+        on = apex + (directrix - apex) * rng.uniform(0.1, 0.95, len(u))[:, None]
+        pts = np.vstack([pts, on])
+        expect_s, expect_angle = np.r_[expect_s, np.linalg.norm(on - apex, axis=1)], np.r_[expect_angle, theta]
     else:
         pts = apex + np.column_stack([h * np.tan(a) * np.cos(pu), h * np.tan(a) * np.sin(pu), h])
         expect_s, expect_angle = h / np.cos(a), pu * np.sin(a)
     uv = develop(cone, np.vstack([apex, pts]))
     np.testing.assert_allclose(uv[0], 0.0, atol=1e-12)  # the apex
     np.testing.assert_allclose(np.hypot(uv[1:, 0], uv[1:, 1]), expect_s, rtol=1e-12)
-    angle = np.arctan2(uv[1:, 1], uv[1:, 0])
-    np.testing.assert_allclose(angle - angle.min(), expect_angle - expect_angle.min(), atol=tol)
+    angle = np.arctan2(uv[1:, 1], uv[1:, 0])  # from the directrix's first line (all within half a turn)
+    np.testing.assert_allclose(angle, expect_angle, atol=tol)
 
 
 def test_offsetting_small_triangles_moves_by_the_offset_along_the_normal():

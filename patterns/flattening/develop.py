@@ -147,7 +147,6 @@ def _develop_general_cone(surface, points: np.ndarray) -> np.ndarray:
     # cone is flat between two rulings: the direction then lies on their great circle).
     k = np.argmax(u @ table.T, axis=1)
     k = np.clip(k, 1, len(table) - 2)
-    best = np.empty(len(k))
     for shift in (-1, 0):
         a, b = table[k + shift], table[k + shift + 1]
         ab = b - a
