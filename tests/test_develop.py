@@ -91,12 +91,13 @@ def test_an_exact_development_says_so_and_runs_counter_clockwise_at_any_size():
         assert np.all(signed_areas(flat.uv, flat.faces) > 0)
 
 
-def test_offsetting_a_cylinder_moves_points_radially():
+@pytest.mark.parametrize("offset", [1.5, 1.0, -2.0])
+def test_offsetting_a_cylinder_moves_points_radially(offset):
     r = 40.0
     u = np.linspace(0.0, 3.0, 5)
     pts = np.column_stack([r * np.cos(u), r * np.sin(u), np.arange(5.0)])
-    moved = offset_points(_surface(SurfaceKind.CYLINDER, radius=r), pts, 1.5)
-    np.testing.assert_allclose(np.hypot(moved[:, 0], moved[:, 1]), r + 1.5, rtol=1e-12)
+    moved = offset_points(_surface(SurfaceKind.CYLINDER, radius=r), pts, offset)
+    np.testing.assert_allclose(np.hypot(moved[:, 0], moved[:, 1]), r + offset, rtol=1e-12)
     np.testing.assert_allclose(moved[:, 2], pts[:, 2], atol=1e-12)
 
 
