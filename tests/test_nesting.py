@@ -204,6 +204,9 @@ def test_sheets_are_filled_one_after_another(plates):
     assert total == pytest.approx(4 * (200 * 100 + 200 * 50 + 100 * 50), rel=1e-9)
     n = len(nest.sheets)
     assert str(nest).startswith(f"{n} sheet{'s' if n != 1 else ''} of 400 x 300 mm, usage ")
+    assert nest.length == 400.0 * n and nest.area_used == 400.0 * 300.0 * n  # the sheets, end to end
+    one = plates.layout(sheet=(2000.0, 1000.0), **QUICK)
+    assert len(one.sheets) == 1 and str(one).startswith("1 sheet of 2000 x 1000 mm, usage ")
 
 
 def test_a_piece_too_big_for_the_sheet_is_refused(plates):
@@ -222,6 +225,18 @@ def test_a_nest_that_breaks_the_gap_is_refused_not_returned(plates):
     placed = [_outline(f, 0.0) for f in laid.panels]
     with pytest.raises(LayoutError, match="under the 10 mm gap"):
         _verify("plates", laid, placed, 5000.0, NestOptions(width=5000.0), [(0.0, -1000.0, 5000.0, None)])
+
+
+def test_a_gap_under_a_millimetre_is_kept_too(plates):
+    """gap=0.5: two pieces 0.2 mm apart are refused."""
+    from patterns.nesting import _outline, _verify
+
+    x1 = _outline(plates.panels[0], 0.0).bounds[2]
+    laid = plates.placed([(0.0, 0.0, 0.0), (0.0, x1 + 0.2 - plates.panels[1].uv[:, 0].min(), 0.0)]
+                         + [(0.0, 1000.0 + 400.0 * k, 0.0) for k in range(4)])
+    placed = [_outline(f, 0.0) for f in laid.panels]
+    with pytest.raises(LayoutError, match="lie 0.200 mm apart, under the 0.5 mm gap"):
+        _verify("plates", laid, placed, 5000.0, NestOptions(width=5000.0, gap=0.5), [(-1e5, -1e5, 1e5, None)])
 
 
 def test_with_no_gap_pieces_may_touch_but_never_overlap(plates):
@@ -354,7 +369,7 @@ def test_sparrow_giving_up_is_a_layout_error():
 
 
 def test_a_piece_too_wide_for_a_sheet_says_sheet():
-    with pytest.raises(LayoutError, match=r"piece .* is 300.0 mm wide, wider than the 400 x 100 mm sheet in every"):
+    with pytest.raises(LayoutError, match=r"^rects: piece .* is 300.0 mm wide, wider than the 400 x 100 mm sheet in "):
         _rectangles([(300.0, 200.0)]).layout(sheet=(400.0, 100.0), **QUICK)
 
 
