@@ -735,6 +735,55 @@ def test_a_notch_a_hair_before_the_end_is_left_out(notched, tmp_path):
     assert len(_notch_lines(read(path))) == sum(2 * expected[round(fs.length)] for fs in pattern.seams)
 
 
+def test_squared_corners_where_a_one_segment_seam_has_its_own_allowance(tmp_path):
+    """A box sewn from faces whose top is three faces (40, 20 and 40 mm wide): the front's and back's
+    top edges are three seams on one straight line, the middle one a single segment. With 10 mm on
+    those middle seams, 5 mm on the rest, and squared corners, each cut line read back is the one
+    built from the definition: each side's strip its own width, run on past the sharp corners only
+    (not where the allowance changes along a straight line)."""
+    def rect(pts):
+        return bd.Face(bd.Wire.make_polygon([bd.Vector(*q) for q in pts], close=True))
+
+    w, d, h = 100.0, 40.0, 30.0
+    faces = [rect([(x0, 0, h), (x1, 0, h), (x1, d, h), (x0, d, h)]) for x0, x1 in ((0, 40), (40, 60), (60, 100))]
+    faces += [rect([(0, 0, 0), (0, d, 0), (w, d, 0), (w, 0, 0)]), rect([(0, 0, 0), (w, 0, 0), (w, 0, h), (0, 0, h)]),
+              rect([(0, d, 0), (0, d, h), (w, d, h), (w, d, 0)]), rect([(0, 0, 0), (0, 0, h), (0, d, h), (0, d, 0)]),
+              rect([(w, 0, 0), (w, d, 0), (w, d, h), (w, 0, h)])]
+    flat = patterns.flatten(patterns.load(bd.Compound(faces), max_edge=25))
+    middle = {fs.seam.id for fs in flat.seams if len(fs.seam.vertices[0]) == 2}  # one segment each
+    assert len(middle) == 2
+    allowance = {None: 5.0, **{k: 10.0 for k in middle}}
+    pattern = flat.placed([(0.0, 300.0 * k, 0.0) for k in range(len(flat.panels))])
+    path = tmp_path / "box.dxf"
+    pattern.to_dxf(path, seam_allowance=allowance, seam_corners="square")
+    doc = read(path)
+    cuts = _polygons(doc, "CUT")
+    shift = drawing_shift(doc.modelspace(), pattern, "SEW")
+    seam_of = {}
+    for fs in pattern.seams:
+        for p, idx in zip(fs.seam.panels, fs.seam.vertices):
+            for a, b in zip(idx[:-1], idx[1:]):
+                seam_of[(p, int(a), int(b))] = seam_of[(p, int(b), int(a))] = fs.seam.id
+    for k, panel in enumerate(pattern.panels):
+        loop = panel.loops[0]
+        pts = panel.uv[loop] + shift
+        widths = np.array([allowance.get(seam_of.get((k, int(a), int(b))), 5.0) for a, b in zip(loop, np.roll(loop, -1))])
+        before, after = pts - np.roll(pts, 1, axis=0), np.roll(pts, -1, axis=0) - pts
+        turn = np.degrees(np.arctan2(before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0], (before * after).sum(1)))
+        ends = np.flatnonzero((np.abs(turn) > 1e-6) | (widths != np.roll(widths, 1)))  # where a side starts
+        strips = [shapely.Polygon(pts)]
+        for i, j in zip(ends, np.roll(ends, -1)):
+            a, p, q = widths[i], pts[i], pts[j]
+            t = (q - p) / np.linalg.norm(q - p)
+            n = np.array([t[1], -t[0]])
+            p0 = p - a * t if turn[i] > 30 else p
+            q0 = q + a * t if turn[j] > 30 else q
+            strips.append(shapely.Polygon([p0, q0, q0 + a * n, p0 + a * n]))
+        expected = shapely.union_all(strips)
+        (cut,) = [c for c in cuts if c.contains(shapely.Polygon(pts).representative_point())]
+        assert cut.symmetric_difference(expected).area < 1e-6 * expected.area, panel.name
+
+
 def test_an_allowance_grows_the_outline_and_shrinks_the_hole(plate, tmp_path):
     """With a 5 mm allowance every cut loop read back is its seam loop offset by 5 mm (mitred):
     the outlines outwards, the hole's inwards -- every point of each (a loop missing one has
