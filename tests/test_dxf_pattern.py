@@ -735,12 +735,14 @@ def test_a_notch_a_hair_before_the_end_is_left_out(notched, tmp_path):
     assert len(_notch_lines(read(path))) == sum(2 * expected[round(fs.length)] for fs in pattern.seams)
 
 
-def test_squared_corners_where_a_one_segment_seam_has_its_own_allowance(tmp_path):
+@pytest.mark.parametrize("corners", ["square", "mitre"])
+def test_corners_where_a_one_segment_seam_has_its_own_allowance(tmp_path, corners):
     """A box sewn from faces whose top is three faces (40, 20 and 40 mm wide): the front's and back's
     top edges are three seams on one straight line, the middle one a single segment. With 10 mm on
-    those middle seams, 5 mm on the rest, and squared corners, each cut line read back is the one
-    built from the definition: each side's strip its own width, run on past the sharp corners only
-    (not where the allowance changes along a straight line)."""
+    those middle seams, 5 mm on the rest, each cut line read back is the one built from the
+    definition: squared, each side's strip its own width, run on past the sharp corners only (not
+    where the allowance changes along a straight line); mitred, the outline grown by 5 mm and the
+    10 mm strips square-ended on it."""
     def rect(pts):
         return bd.Face(bd.Wire.make_polygon([bd.Vector(*q) for q in pts], close=True))
 
@@ -755,7 +757,7 @@ def test_squared_corners_where_a_one_segment_seam_has_its_own_allowance(tmp_path
     allowance = {None: 5.0, **{k: 10.0 for k in middle}}
     pattern = flat.placed([(0.0, 300.0 * k, 0.0) for k in range(len(flat.panels))])
     path = tmp_path / "box.dxf"
-    pattern.to_dxf(path, seam_allowance=allowance, seam_corners="square")
+    pattern.to_dxf(path, seam_allowance=allowance, seam_corners=corners)
     doc = read(path)
     cuts = _polygons(doc, "CUT")
     shift = drawing_shift(doc.modelspace(), pattern, "SEW")
@@ -771,17 +773,53 @@ def test_squared_corners_where_a_one_segment_seam_has_its_own_allowance(tmp_path
         before, after = pts - np.roll(pts, 1, axis=0), np.roll(pts, -1, axis=0) - pts
         turn = np.degrees(np.arctan2(before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0], (before * after).sum(1)))
         ends = np.flatnonzero((np.abs(turn) > 1e-6) | (widths != np.roll(widths, 1)))  # where a side starts
-        strips = [shapely.Polygon(pts)]
+        # mitre: the outline grown by the least allowance, mitred, and each wider side's strip, square-ended
+        strips = [shapely.Polygon(pts).buffer(5.0 if corners == "mitre" else 0.0, join_style="mitre")]
         for i, j in zip(ends, np.roll(ends, -1)):
             a, p, q = widths[i], pts[i], pts[j]
             t = (q - p) / np.linalg.norm(q - p)
             n = np.array([t[1], -t[0]])
-            p0 = p - a * t if turn[i] > 30 else p
-            q0 = q + a * t if turn[j] > 30 else q
+            square = corners == "square"
+            p0 = p - a * t if square and turn[i] > 30 else p
+            q0 = q + a * t if square and turn[j] > 30 else q
             strips.append(shapely.Polygon([p0, q0, q0 + a * n, p0 + a * n]))
         expected = shapely.union_all(strips)
         (cut,) = [c for c in cuts if c.contains(shapely.Polygon(pts).representative_point())]
         assert cut.symmetric_difference(expected).area < 1e-6 * expected.area, panel.name
+
+
+def test_an_allowance_only_for_the_seams_named(plate, tmp_path):
+    """seam_allowance={seam: mm} without a None key: every other edge gets none. The seam's two panels
+    get a seam line (SEW) and a cut line outside it; every other panel is cut on its seam line."""
+    seam = plate.seams[0].seam
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, seam_allowance={seam.id: 8.0})
+    doc = read(path)
+    sews = sorted(ring_numbers(pts) for pts, _ in polylines(doc, "SEW"))
+    cuts = sorted(ring_numbers(pts) for pts, _ in polylines(doc, "CUT"))
+    with_allowance = set(seam.panels)
+    np.testing.assert_allclose(sews, sorted(ring_numbers(plate.panels[k].uv[loop]) for k in with_allowance
+                                            for loop in plate.panels[k].loops), rtol=1e-9)
+    bare = sorted(ring_numbers(flat.uv[loop]) for k, flat in enumerate(plate.panels) if k not in with_allowance
+                  for loop in flat.loops)
+    assert len(cuts) == len(bare) + len(sews)
+    assert all(any(c == pytest.approx(b, rel=1e-9) for c in cuts) for b in bare)
+    assert sum(c[0] for c in cuts) > sum(b[0] for b in bare) + sum(w[0] for w in sews)  # grown where named
+
+
+def test_a_folder_for_the_dxf_is_refused_naming_it(cup, tmp_path):
+    with pytest.raises(ExportError, match=r"is a folder; name a file for the DXF file$"):
+        cup.to_dxf(tmp_path)
+
+
+def test_ezdxf_s_time_stamps_are_fixed(cup, tmp_path):
+    """The file says which ezdxf wrote it, at a fixed time (2000-01-01): the same pattern gives the
+    same bytes tomorrow."""
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path)
+    text = path.read_text(encoding="utf-8", errors="replace")
+    stamps = re.findall(r"\d+\.\d+\.\d+ @ \d{4}-\d\d-\d\dT[\d:.]+\+00:00", text)
+    assert stamps and all(s == f"{ezdxf.__version__} @ 2000-01-01T00:00:00+00:00" for s in stamps)
 
 
 def test_an_allowance_grows_the_outline_and_shrinks_the_hole(plate, tmp_path):
@@ -1312,7 +1350,10 @@ def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance
     """Notches every 40 mm of seam (not only at the ends, where the outline has corners), and with an
     allowance that changes from seam to seam (5 mm, 15 mm along the longest): each starts on the cut
     line and runs into the piece, square to its seam, within the allowance."""
+    from patterns.export.dxf import notch_positions
+
     pattern = notched[part]
+    pattern = pattern.placed([(0.0, 1000.0 * k, 0.0) for k in range(len(pattern.panels))])
     if allowance == "per seam":
         longest = max(pattern.seams, key=lambda fs: fs.length).seam.id
         allowance = {None: 5.0, longest: 15.0}
@@ -1323,6 +1364,15 @@ def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance
     sews = _polygons(doc, "SEW") if allowance else cuts
     lines = _notch_lines(doc)
     assert len(lines) > 4 * len(pattern.seams)  # more than the ends
+    # each where notch_positions puts it, or half a millimetre along its seam (at a step of the cut line)
+    shift = drawing_shift(doc.modelspace(), pattern, "SEW" if allowance else "CUT")
+    marks = np.array([point + shift for fs in pattern.seams for side in (0, 1)
+                      for _, point, _ in notch_positions(fs, side, pattern.panels[fs.seam.panels[side]].uv, 40.0)])
+    ends = lines.reshape(-1, 2)
+    assert len(lines) == len(marks)
+    assert max(np.linalg.norm(marks - e, axis=1).min() for e in ends) > 1.0  # the outer ends: on the cut line
+    inner = [min(np.linalg.norm(marks - a, axis=1).min(), np.linalg.norm(marks - b, axis=1).min()) for a, b in lines]
+    assert max(inner) <= 0.5 + 1e-6
     for a, b in lines:
         mid = shapely.Point((a + b) / 2)
         cut = cuts[int(np.argmin([c.distance(mid) for c in cuts]))]

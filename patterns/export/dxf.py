@@ -646,9 +646,7 @@ def _machine_doc(ezdxf, pattern, geos, allowance_of, offsets, opts: DxfOptions):
     bend_spacing, notch_spacing, notch_style, strain_layer = (opts.bend_spacing, opts.notch_spacing,
                                                               opts.notch_style, opts.strain_layer)
     r12 = version == "R12"
-    doc = _new_doc(ezdxf, version, 0 if r12 else unit.insunits)
-    if not r12:
-        doc.header["$INSUNITS"] = unit.insunits
+    doc = _new_doc(ezdxf, version, 0 if r12 else unit.insunits)  # $INSUNITS (R12 has none)
     doc.header["$MEASUREMENT"] = unit.measurement
     stock = getattr(pattern, "stock", ())
     for name, color in MACHINE_LAYERS.items():
