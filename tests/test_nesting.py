@@ -110,7 +110,7 @@ def test_the_margin_is_kept_around_each_outline():
     ({"width": 100.0, "sheet": (100, 100)}, "a roll \\(width\\) or on sheets \\(sheet\\), not both"),
     ({"sheet": (100, -1)}, "sheet width \\(mm\\) must be"), ({}, "give a roll width or a sheet"),
     ({"width": 100.0, "copies": 0}, "copies must be"), ({"width": 100.0, "quantities": {"nope": 2}},
-                                                         "quantities name panel 'nope'"),
+                                                         "quantities name panel 'nope'; the panels are face0, face1, "),
     ({"width": 100.0, "time_limit": 0}, "time_limit must be")])
 def test_bad_nest_options(plates, kwargs, words):
     """One line naming the pattern and the option."""
@@ -119,7 +119,7 @@ def test_bad_nest_options(plates, kwargs, words):
 
 
 def test_only_a_pattern_is_nested():
-    with pytest.raises(InputError, match="layout\\(\\) takes a patterns.Pattern"):
+    with pytest.raises(InputError, match="^layout\\(\\) takes a patterns.Pattern, got Almost$"):
         patterns.layout(type("Almost", (), {"panels": (), "name": "x"})(), width=100.0)
 
 
@@ -203,7 +203,8 @@ def test_sheets_are_filled_one_after_another(plates):
     assert nest.efficiency == pytest.approx(total / (len(nest.sheets) * 400.0 * 300.0), rel=1e-9)
     assert total == pytest.approx(4 * (200 * 100 + 200 * 50 + 100 * 50), rel=1e-9)
     n = len(nest.sheets)
-    assert str(nest).startswith(f"{n} sheet{'s' if n != 1 else ''} of 400 x 300 mm, usage ")
+    assert str(nest) == (f"{n} sheet{'s' if n != 1 else ''} of 400 x 300 mm, usage "
+                         + ", ".join(f"{s.usage:.1%}" for s in nest.sheets) + f" ({nest.efficiency:.1%} in all)")
     assert nest.length == 400.0 * n and nest.area_used == 400.0 * 300.0 * n  # the sheets, end to end
     one = plates.layout(sheet=(2000.0, 1000.0), **QUICK)
     assert len(one.sheets) == 1 and str(one).startswith("1 sheet of 2000 x 1000 mm, usage ")
@@ -258,7 +259,8 @@ def test_with_no_gap_pieces_may_touch_but_never_overlap(plates):
 
 
 @pytest.mark.parametrize(("sheet", "words"), [((1e8, 100.0), "sheet length (mm)"), ((100.0, 1e8), "sheet width (mm)"),
-                                              ((0.0, 100.0), "sheet length (mm)"), ((100.0, -5.0), "sheet width (mm)")])
+                                              ((0.0, 100.0), "sheet length (mm)"), ((100.0, -5.0), "sheet width (mm)"),
+                                              ((100.0, 0.0), "sheet width (mm) must be a positive number")])
 def test_a_sheet_out_of_bounds_is_named(sheet, words):
     with pytest.raises(InputError, match=re.escape(words)):
         NestOptions(sheet=sheet)
