@@ -261,13 +261,38 @@ def test_strain_layer(cup, tmp_path):
         k += len(flat.faces)
 
 
-def test_strain_colours_are_the_version_s(cup, tmp_path):
-    """True colour from R2004 on; R2000 has none (ACI red or blue)."""
+@pytest.mark.parametrize("version", ["R12", "R2000"])
+def test_strain_colours_are_the_version_s(cup, tmp_path, version):
+    """True colour from R2004 on; R12 and R2000 have none (ACI red or blue)."""
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, strain_layer=True, version="R2000")
+    cup.to_dxf(path, strain_layer=True, version=version)
     solids = read(path).modelspace().query('SOLID[layer=="STRAIN"]')
     assert len(solids) > 0 and not any(s.dxf.hasattr("true_color") for s in solids)
     assert {s.dxf.color for s in solids} == {1, 5}
+
+
+def test_labels_read_left_to_right():
+    """A label along a direction is turned to read left to right, never upside down: its angle lies in
+    (-90, 90] degrees, the direction's or the opposite one's."""
+    from patterns.export.dxf import _readable_angle
+
+    cases = {(1, 0): 0.0, (0, 1): 90.0, (0, -1): 90.0, (-1, 0): 0.0, (1, 1): 45.0, (-1, -1): 45.0,
+             (-1, 1): -45.0, (1, -1): -45.0, (-1, 1e-9): pytest.approx(-1e-9 * 180 / np.pi, abs=1e-12)}
+    for direction, angle in cases.items():
+        assert _readable_angle(np.array(direction, dtype=float)) == pytest.approx(angle, abs=1e-12)
+
+
+def test_grain_lines_lie_inside_their_pieces(cup, plate, tmp_path):
+    for name, pattern in (("cup", cup), ("plate", plate)):
+        path = tmp_path / f"{name}.dxf"
+        pattern.to_dxf(path)
+        doc = read(path)
+        cuts = _polygons(doc, "CUT")
+        lines = doc.modelspace().query('LINE[layer=="GRAIN"]')
+        assert len(lines) == len(pattern.panels)
+        for line in lines:
+            a, b = shapely.Point(tuple(line.dxf.start)[:2]), shapely.Point(tuple(line.dxf.end)[:2])
+            assert any(c.contains(a) and c.contains(b) for c in cuts), name
 
 
 def test_a_text_height_given_is_the_text_height(cup, tmp_path):
@@ -404,6 +429,14 @@ def test_readers_are_present_in_ci():
 
 def _polygons(doc, layer):
     return [shapely.Polygon(pts) for pts, closed in polylines(doc, layer) if closed]
+
+
+def _pieces(doc, layer):
+    """The closed polylines of ``layer`` as pieces: each ring not inside another, with the rings inside
+    it as its holes."""
+    rings = _polygons(doc, layer)
+    outer = [r for r in rings if not any(o is not r and o.contains(r) for o in rings)]
+    return [shapely.Polygon(o.exterior, [r.exterior for r in rings if r is not o and o.contains(r)]) for o in outer]
 
 
 def test_notch_slits_cut_into_the_allowance_never_into_the_piece(cup, tmp_path):
@@ -839,6 +872,26 @@ def test_an_allowance_grows_the_outline_and_shrinks_the_hole(plate, tmp_path):
     np.testing.assert_allclose(found, expected, rtol=1e-9)
 
 
+def test_a_hole_s_own_allowance_is_drawn(plate, tmp_path):
+    """seam_allowance 10 mm on the hole's seams, 5 mm elsewhere: the plate's outlines grow by 5 mm, the
+    holes shrink by 10 (a panel whose outline has the least allowance still gets its hole's)."""
+    holed = [k for k, flat in enumerate(plate.panels) if len(flat.loops) > 1]
+    hole_seams = {fs.seam.id for fs in plate.seams
+                  if any(p in holed and not set(idx.tolist()) - set(plate.panels[p].loops[1].tolist())
+                         for p, idx in zip(fs.seam.panels, fs.seam.vertices))}
+    assert hole_seams
+    path = tmp_path / "plate.dxf"
+    plate.to_dxf(path, seam_allowance={None: 5.0, **{k: 10.0 for k in hole_seams}})
+    found = sorted(ring_numbers(pts) for pts, _ in polylines(read(path), "CUT"))
+    expected = []
+    for k in holed:
+        outline, hole = (shapely.Polygon(plate.panels[k].uv[loop]) for loop in plate.panels[k].loops)
+        expected += [outline.buffer(5.0, join_style="mitre"), hole.buffer(-10.0, join_style="mitre")]
+    expected = sorted((g.area, g.exterior.length) for g in expected)
+    for e in expected:  # the holed panels' loops among the cut loops read back
+        assert any(np.allclose(f, e, rtol=1e-6) for f in found), e
+
+
 def test_a_panel_too_small_to_draw_is_refused_at_any_angle(tmp_path):
     """A 6 mm-thousandths square laid out along its diagonal: 0.0085 mm across each way (under the
     0.01 mm a DXF draws), 0.0127 mm from its lowest coordinate to its highest -- refused, by its
@@ -924,10 +977,11 @@ def test_write_outline_dxf_checks_every_loop_and_writes_them_as_given(tmp_path):
 
 @pytest.fixture(scope="module")
 def notched():
-    """The box, the cup and the square-to-round, flattened once."""
+    """The box, the cup, the square-to-round and a plate with a hole, flattened once."""
     return {"box": patterns.flatten(patterns.load(bd.Box(200, 100, 50), max_edge=10)),
             "cup": patterns.flatten(patterns.load(SAMPLES / "cup.step")),
-            "square_to_round": patterns.flatten(patterns.load(SAMPLES / "square_to_round.step"))}
+            "square_to_round": patterns.flatten(patterns.load(SAMPLES / "square_to_round.step")),
+            "plate": patterns.flatten(patterns.load(bd.Box(200, 100, 50) - bd.Cylinder(20, 50), max_edge=10))}
 
 
 def _notch_lines(doc):
@@ -1345,7 +1399,7 @@ def test_dxf2gcode_finds_each_astm_piece_closed(notched, tmp_path, part):
 
 @pytest.mark.parametrize(("part", "allowance"), [
     ("box", 0.0), ("box", 10.0), ("box", "per seam"), ("square_to_round", 0.0), ("square_to_round", 10.0),
-    ("square_to_round", "per seam")])
+    ("square_to_round", "per seam"), ("plate", 0.0), ("plate", 10.0)])
 def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance):
     """Notches every 40 mm of seam (not only at the ends, where the outline has corners), and with an
     allowance that changes from seam to seam (5 mm, 15 mm along the longest): each starts on the cut
@@ -1360,8 +1414,8 @@ def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance
     path = tmp_path / f"{part}.dxf"
     pattern.to_dxf(path, seam_allowance=allowance, notch_spacing=40.0)
     doc = read(path)
-    cuts = _polygons(doc, "CUT")
-    sews = _polygons(doc, "SEW") if allowance else cuts
+    cuts = _pieces(doc, "CUT")  # with their holes: notches on a hole's seam start on the hole's cut line
+    sews = _pieces(doc, "SEW") if allowance else cuts
     lines = _notch_lines(doc)
     assert len(lines) > 4 * len(pattern.seams)  # more than the ends
     # each where notch_positions puts it, or half a millimetre along its seam (at a step of the cut line)
@@ -1377,13 +1431,13 @@ def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance
         mid = shapely.Point((a + b) / 2)
         cut = cuts[int(np.argmin([c.distance(mid) for c in cuts]))]
         sew = sews[int(np.argmin([s.distance(mid) for s in sews]))]
-        on_cut = [cut.exterior.distance(shapely.Point(p)) < 1e-6 for p in (a, b)]
+        on_cut = [cut.boundary.distance(shapely.Point(p)) < 1e-6 for p in (a, b)]
         assert any(on_cut)
         outer, inner = (a, b) if on_cut[0] else (b, a)
         if allowance:  # ends on the seam line (as drawn: its straight runs one segment within 0.001 mm)
-            assert sew.exterior.distance(shapely.Point(inner)) < 1e-3
+            assert sew.boundary.distance(shapely.Point(inner)) < 1e-3
         for t in (0.25, 0.5, 0.75):
             q = shapely.Point(outer + t * (inner - outer))
-            assert cut.contains(q) and cut.exterior.distance(q) > 1e-3
+            assert cut.contains(q) and cut.boundary.distance(q) > 1e-3
             if allowance:
                 assert not sew.buffer(-1e-6).contains(q)
