@@ -302,6 +302,56 @@ def test_a_text_height_given_is_the_text_height(cup, tmp_path):
     assert units.dxf.height == 7.0
 
 
+def test_astm_texts_are_six_tenths_of_the_text_height(cup, tmp_path):
+    """ASTM text_height=5: the style's lines in model space and every piece's text (its lines, its seam
+    labels) are 3 mm high, 0.6 of it."""
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, profile="astm", text_height=5.0)
+    doc = read(path)
+    texts = list(doc.modelspace().query("TEXT"))
+    texts += [t for insert in doc.modelspace().query("INSERT") for t in doc.blocks[insert.dxf.name].query("TEXT")]
+    seam_labels = [t for t in texts if t.dxf.text.startswith("S") and " 3D " in t.dxf.text]
+    assert len(texts) > 7 and seam_labels
+    np.testing.assert_allclose([t.dxf.height for t in texts], 3.0, rtol=1e-12)
+
+
+def test_marks_are_counted_before_drawing():
+    """check_marks' estimates: 2 x (seam length / notch spacing + seams) notches, the panels' sizes over
+    the bend spacing for bend lines; refused over MAX_MARKS, not under."""
+    from patterns.export.dxf import MAX_MARKS, DxfOptions, check_marks
+
+    seams, sizes = [1000.0] * 10, [500.0] * 8  # 10 m of seams, 4 m of panels
+    notch_at = 2 * (10_000.0 / MAX_MARKS)  # about MAX_MARKS / 2 ... / 1 notches below and above
+    check_marks("p", seams, sizes, DxfOptions(notch_spacing=notch_at * 1.1))
+    with pytest.raises(InputError, match=r"^p: notch_spacing .* would draw about"):
+        check_marks("p", seams, sizes, DxfOptions(notch_spacing=notch_at * 0.9))
+    bend_at = 4000.0 / MAX_MARKS
+    check_marks("p", seams, sizes, DxfOptions(bend_spacing=bend_at * 1.1))
+    with pytest.raises(InputError, match=r"^p: bend_spacing .* would draw up to .* bend lines across 8 panels"):
+        check_marks("p", seams, sizes, DxfOptions(bend_spacing=bend_at * 0.9))
+    check_marks("p", [], [], DxfOptions(notch_spacing=1e-3, bend_spacing=1e-3))  # nothing to mark
+
+
+def test_snap_drops_repeated_points_and_the_closing_one():
+    from patterns.export.dxf import _snap
+
+    square = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], dtype=float)
+    np.testing.assert_array_equal(_snap(np.vstack([square, square[:1]])), square)  # closed by repeating
+    np.testing.assert_array_equal(_snap(np.vstack([square[:2], square[1:2] + 1e-9, square[2:]])), square)
+    triangle = square[:3]
+    np.testing.assert_array_equal(_snap(np.vstack([triangle, triangle[:1]])), triangle)
+
+
+def test_arcs_are_for_the_cut_line_only(cup, tmp_path):
+    """arcs=True: the cut contours are fitted with arcs (bulges); the seam lines are drawn as they are."""
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path, arcs=True, seam_allowance=10.0)
+    msp = read(path).modelspace()
+    bulges = {layer: [b for e in msp.query(f'LWPOLYLINE[layer=="{layer}"]') for *_, b in e.get_points("xyb")]
+              for layer in ("CUT", "SEW")}
+    assert any(b != 0 for b in bulges["CUT"]) and not any(b != 0 for b in bulges["SEW"])
+
+
 def test_a_per_seam_allowance_is_bounded_too(cup, tmp_path):
     with pytest.raises(InputError, match="seam_allowance"):
         cup.to_dxf(tmp_path / "cup.dxf", seam_allowance={None: 5.0, cup.seams[0].seam.id: 1e6})
