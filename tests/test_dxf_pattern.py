@@ -352,6 +352,34 @@ def test_arcs_are_for_the_cut_line_only(cup, tmp_path):
     assert any(b != 0 for b in bulges["CUT"]) and not any(b != 0 for b in bulges["SEW"])
 
 
+def test_layers_are_declared_only_when_used(cup, tmp_path):
+    """STOCK (a nest's roll or sheets) and STRAIN (the strain solids) are declared only when drawn."""
+    path = tmp_path / "cup.dxf"
+    cup.to_dxf(path)
+    layers = {layer.dxf.name for layer in read(path).layers}
+    assert {"CUT", "LABEL", "NOTCH", "GRAIN"} <= layers and not {"STOCK", "STRAIN"} & layers
+    cup.to_dxf(path, strain_layer=True)
+    assert "STRAIN" in {layer.dxf.name for layer in read(path).layers}
+
+
+def test_seam_labels_lie_inside_their_panel_near_their_seam(cup, tmp_path):
+    """Each seam's label (S<id> 3D ... FLAT ...) lies inside its panel, about a label height from its
+    seam: 1.6 x its own height, within the panel's own seam polyline's reach."""
+    path = tmp_path / "cup.dxf"
+    pattern = cup.placed([(0.0, 400.0 * k, 0.0) for k in range(len(cup.panels))])
+    pattern.to_dxf(path)
+    doc = read(path)
+    shift = drawing_shift(doc.modelspace(), pattern, "CUT")
+    labels = [t for t in doc.modelspace().query('TEXT[layer=="LABEL"]') if re.match(r"S\d+ 3D ", t.dxf.text)]
+    assert len(labels) == 2 * len(pattern.seams)
+    for t in labels:
+        sid = int(t.dxf.text[1:].split()[0])
+        (fs,) = [fs for fs in pattern.seams if fs.seam.id == sid]
+        at = shapely.Point(np.array(t.dxf.align_point)[:2] - shift)
+        lines = [shapely.LineString(pattern.panels[p].uv[idx]) for p, idx in zip(fs.seam.panels, fs.seam.vertices)]
+        assert min(line.distance(at) for line in lines) == pytest.approx(1.6 * t.dxf.height, rel=0.05)
+
+
 def test_a_per_seam_allowance_is_bounded_too(cup, tmp_path):
     with pytest.raises(InputError, match="seam_allowance"):
         cup.to_dxf(tmp_path / "cup.dxf", seam_allowance={None: 5.0, cup.seams[0].seam.id: 1e6})

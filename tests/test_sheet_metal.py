@@ -205,6 +205,10 @@ def test_bend_lines_on_the_bend_layer(hopper, tmp_path):
         along = (at - a) @ (b - a) / ((b - a) @ (b - a))
         assert shapely.LineString([a, b]).distance(shapely.Point(at)) < 1e-6 and 0.05 < along < 0.95
         assert abs(abs(np.cos(np.radians(t.dxf.rotation) - np.arctan2(*(b - a)[::-1])))) == pytest.approx(1.0)
+    names = [t for t in doc.modelspace().query('TEXT[layer=="LABEL"]') if t.dxf.text == hopper.panels[0].name]
+    assert len(names) == 1  # the panel's name: 1.2 text heights; a bend label: half of one
+    assert {round(t.dxf.height / names[0].dxf.height, 9) for t in doc.modelspace().query('TEXT[layer=="BEND"]')} == {
+        round(0.5 / 1.2, 9)}
     cylinder = patterns.flatten(patterns.load(SAMPLES / "rolled_cylinder.step")).panels[0]
     rulings = cylinder.rulings(100.0)
     # Along the axis (its flat direction is averaged over the chord triangles: 2e-5 mm off over 500).
