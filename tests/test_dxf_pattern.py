@@ -178,6 +178,7 @@ def test_astm_profile_is_piece_blocks_for_garment_cad(cup, tmp_path):
     assert style[0] == "ASTM/D6673/10" and style[1:2] == [f"Style Name:{cup.name}"]
     assert re.fullmatch(r"Creation Date:\d\d-\d\d-\d{4}", style[2])
     assert style[3:] == ["Author:patterns", "Sample Size:BASE", "Grading Rule Table:", "Units:METRIC"]
+    assert {t.dxf.layer for t in doc.modelspace().query("TEXT")} == {"1"}  # the style's text: layer 1
     used = {e.dxf.layer for e in doc.modelspace()} | {e.dxf.layer for b in doc.blocks if not b.is_any_layout for e in b}
     assert used <= {layer.dxf.name for layer in doc.layers}
     for insert, flat in zip(inserts, cup.panels):
