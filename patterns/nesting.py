@@ -282,29 +282,24 @@ def _item_points(shape) -> np.ndarray:
     return np.column_stack([pts[:, 1], -pts[:, 0]])
 
 
-def _least_width(shape, rotations: str) -> float:
-    """The least width (mm) the piece takes across the strip, over the turns allowed."""
+def _extents(shape, rotations: str) -> np.ndarray:
+    """``(k, 2)`` float64, mm: the piece's width across the strip and length along it, turned by each of
+    the turns allowed (for free turns, every degree)."""
     angles = _TRIED if _ANGLES[rotations] is None else _ANGLES[rotations]
-    return min(float(np.ptp(shapely.get_coordinates(affinity.rotate(shape, a))[:, 0])) for a in angles)
+    boxes = np.array([affinity.rotate(shape, a).bounds for a in angles])
+    return boxes[:, 2:] - boxes[:, :2]
 
 
 def _check_fits(name, piece, shape, across, along, rotations):
-    width = _least_width(shape, rotations)
+    extents = _extents(shape, rotations)
+    width = float(extents[:, 0].min())
     if width > across + 1e-9:
         what = f"{across:g} mm roll" if along is None else f"{along:g} x {across:g} mm sheet"
         raise LayoutError(f"{name}: piece {piece} is {width:.1f} mm wide, wider than the {what} in every allowed "
                           f"orientation (rotations={rotations!r})")
-    if along is not None and not _fits_sheet(shape, across, along, rotations):
+    if along is not None and not np.any((extents[:, 0] <= across + 1e-9) & (extents[:, 1] <= along + 1e-9)):
         raise LayoutError(f"{name}: piece {piece} does not fit on a {along:g} x {across:g} mm sheet in any allowed "
                           f"orientation (rotations={rotations!r})")
-
-
-def _fits_sheet(shape, across, along, rotations) -> bool:
-    for a in _TRIED if _ANGLES[rotations] is None else _ANGLES[rotations]:
-        x0, y0, x1, y1 = affinity.rotate(shape, a).bounds
-        if x1 - x0 <= across + 1e-9 and y1 - y0 <= along + 1e-9:
-            return True
-    return False
 
 
 def _tolerance(across: float) -> float:

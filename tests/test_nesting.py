@@ -215,41 +215,41 @@ def test_a_piece_too_big_for_the_sheet_is_refused(plates):
         plates.layout(sheet=(150.0, 300.0), rotations="none", **QUICK)
 
 
+def _side_by_side(plates, step):
+    """The plates laid out with panel 1 ``step`` mm to the right of panel 0 (negative: overlapping), the
+    others far off: ``(pattern, placed outlines)``."""
+    from patterns.nesting import _outline
+
+    x1 = _outline(plates.panels[0], 0.0).bounds[2]
+    laid = plates.placed([(0.0, 0.0, 0.0), (0.0, x1 + step - plates.panels[1].uv[:, 0].min(), 0.0)]
+                         + [(0.0, 1000.0 + 400.0 * k, 0.0) for k in range(4)])
+    return laid, [_outline(f, 0.0) for f in laid.panels]
+
+
 def test_a_nest_that_breaks_the_gap_is_refused_not_returned(plates):
     """The shapely check itself: two pieces 1 mm apart under a 10 mm gap are refused."""
-    from patterns.nesting import _outline, _verify
+    from patterns.nesting import _verify
 
-    first = _outline(plates.panels[0], 0.0)
-    x1 = first.bounds[2]
-    laid = plates.placed([(0.0, 0.0, 0.0), (0.0, x1 + 1.0 - plates.panels[1].uv[:, 0].min(), 0.0)]
-                         + [(0.0, 1000.0 + 400.0 * k, 0.0) for k in range(4)])
-    placed = [_outline(f, 0.0) for f in laid.panels]
+    laid, placed = _side_by_side(plates, 1.0)
     with pytest.raises(LayoutError, match="under the 10 mm gap"):
         _verify("plates", laid, placed, 5000.0, NestOptions(width=5000.0), [(0.0, -1000.0, 5000.0, None)])
 
 
 def test_a_gap_under_a_millimetre_is_kept_too(plates):
     """gap=0.5: two pieces 0.2 mm apart are refused."""
-    from patterns.nesting import _outline, _verify
+    from patterns.nesting import _verify
 
-    x1 = _outline(plates.panels[0], 0.0).bounds[2]
-    laid = plates.placed([(0.0, 0.0, 0.0), (0.0, x1 + 0.2 - plates.panels[1].uv[:, 0].min(), 0.0)]
-                         + [(0.0, 1000.0 + 400.0 * k, 0.0) for k in range(4)])
-    placed = [_outline(f, 0.0) for f in laid.panels]
+    laid, placed = _side_by_side(plates, 0.2)
     with pytest.raises(LayoutError, match="lie 0.200 mm apart, under the 0.5 mm gap"):
         _verify("plates", laid, placed, 5000.0, NestOptions(width=5000.0, gap=0.5), [(-1e5, -1e5, 1e5, None)])
 
 
 def test_with_no_gap_pieces_may_touch_but_never_overlap(plates):
     """gap=0: two pieces that share an edge pass the shapely check; two that overlap by 1 mm are refused."""
-    from patterns.nesting import _outline, _verify
+    from patterns.nesting import _verify
 
-    first = _outline(plates.panels[0], 0.0)
-    x1 = first.bounds[2]
     for step, ok in ((0.0, True), (-1.0, False)):
-        laid = plates.placed([(0.0, 0.0, 0.0), (0.0, x1 + step - plates.panels[1].uv[:, 0].min(), 0.0)]
-                             + [(0.0, 1000.0 + 400.0 * k, 0.0) for k in range(4)])
-        placed = [_outline(f, 0.0) for f in laid.panels]
+        laid, placed = _side_by_side(plates, step)
         args = ("plates", laid, placed, 5000.0, NestOptions(width=5000.0, gap=0.0), [(-1e5, -1e5, 1e5, None)])
         if ok:
             _verify(*args)
