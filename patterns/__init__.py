@@ -12,14 +12,17 @@ The public API, all importable from the top level::
     result.overlap.one_to_one, result.distortion.strain_rms
 
     blank = patterns.unfold("bracket.step", k_factor=0.44)   # bent sheet metal: one flat blank
-    blank.to_dxf("bracket.dxf")                        # outline, holes, bend lines
+    patterns.write(blank, "bracket.dxf")               # outline, holes, bend lines; or .svg, .json
+    patterns.write(pattern, "cup.dxf", seam_allowance=10)
+    nest = patterns.layout([pattern, blank], sheet=(2500, 1250))   # pieces of both on sheets
+    patterns.write(nest, "marker.dxf")
 
     result = patterns.batch("parts/", "out/", jobs=2)  # a folder of parts: a row each
 """
 
-from .audit import CheckOptions, Code, DartReport, Finding, PanelReport, Report, SeamReport, Severity, check
+from .audit import CheckOptions, DartReport, PanelReport, Report, SeamReport, check
 from .batching import BatchOptions, BatchResult, Row, batch
-from .blank import Bend, Blank, BlankCode, BlankFinding
+from .blank import Bend, Blank
 from .comparison import BlankComparison, compare_blank, read_flat_pattern
 from .cut import Cut, cut_to_disk
 from .errors import (
@@ -31,19 +34,20 @@ from .errors import (
     MeshTopologyError,
     PatternsError,
 )
-from .export import heat_map, preview_dxf
-from .export.dxf import DxfOptions
+from .export import WriteOptions, heat_map, preview_dxf, write
 from .flattening import METHODS, Flattening, FlattenOptions, flatten, flatten_mesh
 from .flattening.energy import ENERGIES
+from .findings import Code, Finding, Severity
 from .flattening.seams import Ease, SeamLengths
-from .flattening.sheetmetal import BendTable, UnfoldOptions, read_bend_table, unfold
 from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
 from .model import Bookkeeping, Model, Panel, Seam, Surface, SurfaceKind
 from .nesting import Layout, NestOptions, layout
 from .pattern import Dart, FlatPanel, FlatSeam, Pattern
+from .pieces import Drawing, Piece, PieceOptions, pieces_of
 from .predicates import Overlap, overlap_verdict
 from .reading import LoadOptions, load, read_cad, read_mesh
+from .sheetmetal import BendTable, UnfoldOptions, read_bend_table, unfold
 from .tessellate import MeshingOptions, mesh_shape, tessellate_face
 from .units import Unit
 
@@ -57,9 +61,7 @@ __all__ = [
     "BatchResult",
     "BendTable",
     "Blank",
-    "BlankCode",
     "BlankComparison",
-    "BlankFinding",
     "Bookkeeping",
     "CadError",
     "CheckOptions",
@@ -69,7 +71,7 @@ __all__ = [
     "Dart",
     "DartReport",
     "Distortion",
-    "DxfOptions",
+    "Drawing",
     "Ease",
     "ExportError",
     "Finding",
@@ -90,6 +92,8 @@ __all__ = [
     "Panel",
     "PanelReport",
     "Pattern",
+    "Piece",
+    "PieceOptions",
     "PatternsError",
     "Report",
     "Row",
@@ -102,6 +106,7 @@ __all__ = [
     "SurfaceKind",
     "UnfoldOptions",
     "Unit",
+    "WriteOptions",
     "__version__",
     "batch",
     "check",
@@ -115,6 +120,7 @@ __all__ = [
     "load",
     "mesh_shape",
     "overlap_verdict",
+    "pieces_of",
     "preview_dxf",
     "read_bend_table",
     "read_cad",
@@ -123,4 +129,5 @@ __all__ = [
     "tessellate_face",
     "unfold",
     "validate_mesh",
+    "write",
 ]

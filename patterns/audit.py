@@ -1,110 +1,35 @@
-"""Check a pattern before cutting: an auditor that collects findings (overlaps, strain, seams).
+"""Check a pattern or a blank before cutting: an auditor that collects findings (overlaps, strain, seams).
 
 The geometric predicates it rests on (the overlap verdict, crossing outlines)
-live in :mod:`patterns.predicates`; they are re-exported here.
+live in :mod:`patterns.predicates`; they are re-exported here.  The finding
+type is the one :func:`patterns.unfold` reports with (:mod:`patterns.findings`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from enum import Enum
+from dataclasses import dataclass, replace
 
 import numpy as np
 import shapely
 
+from .blank import Blank
 from .errors import InputError
-from .files import atomic_output
+from .curves import Motion
+from .findings import Code, Finding, Severity
 from .measure import edge_strain, folded_faces, strain_stats
 from .model import Bookkeeping
 from .options import Options, option
 from .pattern import Pattern
+from .pieces import Drawing
 from .predicates import Overlap, boundary_crossings, crossing_segments, flat_polygon, overlap_verdict
 
-__all__ = ["REPORT_SCHEMA", "CheckOptions", "Code", "DartReport", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
-           "boundary_crossings", "check", "crossing_segments", "overlap_verdict"]
+__all__ = ["CheckOptions", "Code", "DartReport", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
+           "boundary_crossings", "check", "checked_drawing", "crossing_segments", "overlap_verdict"]
 
 
 # --------------------------------------------------------------------------- #
 # The report: an auditor that collects findings, never raises on geometry
 # --------------------------------------------------------------------------- #
-
-
-class Severity(str, Enum):
-    """How bad a :class:`Finding` is."""
-
-    ERROR = "error"
-    """The pattern cannot be cut as it is (folds, overlaps)."""
-    LIMIT = "limit"
-    """A limit the user asked for is exceeded (``max_strain``, ``max_seam_mismatch``)."""
-    NOTE = "note"
-    """Worth knowing, not a failure (the relaxation stopped before converging)."""
-
-
-class Code(str, Enum):
-    """What a :class:`Finding` is about (also its JSON ``code``)."""
-
-    FOLDED_TRIANGLES = "folded-triangles"
-    OUTLINE_CROSSES_ITSELF = "outline-crosses-itself"
-    HOLE_CROSSES_OUTLINE = "hole-crosses-outline"
-    HOLE_OUTSIDE_OUTLINE = "hole-outside-outline"
-    INSIDE_OUT = "inside-out"
-    PANELS_OVERLAP = "panels-overlap"
-    STRAIN_ABOVE_LIMIT = "strain-above-limit"
-    SEAM_MISMATCH_ABOVE_LIMIT = "seam-mismatch-above-limit"
-    SEAM_LENGTH_NOT_KEPT = "seam-length-not-kept"
-    AREA_NOT_KEPT = "area-not-kept"
-    GROSSLY_DISTORTED = "grossly-distorted"
-    NOT_CONVERGED = "not-converged"
-    DARTS = "darts"
-
-
-@dataclass(frozen=True, eq=False)
-class Finding:
-    """One thing the check found.
-
-    Attributes
-    ----------
-    code : Code
-    severity : Severity
-    panels : tuple of str
-        The panel (or the two panels) concerned; empty for a seam-only finding.
-    points : (k, 2) float64, mm
-        Where, in the flat pattern as placed (crossing points, centres of folded
-        triangles, a point inside an overlap, the worst triangle's centre).
-    faces : (j,) int64
-        Triangles concerned (folded, or above the strain limit), indices into
-        the panel's faces; empty when not about triangles.  ``points`` and
-        ``faces`` are the finding's own copies, read-only.
-    seam : int or None
-        The seam concerned.
-    message : str
-        One line, starting with the panel or seam.
-    """
-
-    code: Code
-    severity: Severity
-    panels: tuple
-    points: np.ndarray
-    faces: np.ndarray
-    seam: int | None
-    message: str
-
-    def __post_init__(self):
-        for name, dtype in (("points", np.float64), ("faces", np.int64)):  # the finding's own, read-only
-            value = np.array(getattr(self, name), dtype=dtype)
-            value.setflags(write=False)
-            object.__setattr__(self, name, value)
-
-    def to_dict(self) -> dict:
-        return {
-            "code": self.code.value,
-            "severity": self.severity.value,
-            "panels": list(self.panels),
-            "seam": self.seam,
-            "points": self.points.tolist(),
-            "faces": self.faces.tolist(),
-            "message": self.message,
-        }
 
 
 @dataclass(frozen=True)
@@ -169,21 +94,18 @@ class SeamReport:
     length_3d: float
     """The seam's exact length (the CAD edge's curve length)."""
     length_3d_polyline: float
-    """The 3D length of the polyline the flat lengths are measured along (shorter than
-    ``length_3d`` on a curve by the chords' sag): compare flat lengths with this."""
+    """The 3D length of the polyline a relaxed side's flat length is measured along (shorter
+    than ``length_3d`` on a curve by the chords' sag): compare a relaxed side with this."""
     length_flat: tuple
-    """Flat length on side 0 and on side 1."""
+    """Flat length on side 0 and on side 1: a relaxed side's flat polyline, an exactly
+    developed side's exact curve laid flat (:attr:`patterns.FlatSeam.flat_lengths`)."""
     length_held: tuple | None
     """The flat length each side was held at (``flatten(seams="true")``: its 3D polyline
-    length times its ease); None for a free seam."""
+    length times its ease; None for a side that is an exact development); None for a free seam."""
     mismatch: float
     """``length_flat[0] - length_flat[1]``, mm."""
     mismatch_percent: float
     """``mismatch / length_3d * 100``."""
-
-
-REPORT_SCHEMA = "patterns.report/4"
-"""The ``schema`` value of :meth:`Report.to_dict` (see docs/report.md)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -205,6 +127,8 @@ class Report:
     loading : patterns.Bookkeeping
         What loading did to the input (vertices welded, pieces split, cuts
         made, units converted); nothing, for a report made by hand.
+    blanks : tuple of patterns.Blank
+        The sheet-metal blanks checked (their size, bends and findings).
     """
 
     pattern: str
@@ -216,6 +140,7 @@ class Report:
     area_tolerance: float | None = None
     max_distortion: float | None = None
     loading: Bookkeeping = Bookkeeping()
+    blanks: tuple = ()
 
     @property
     def ok(self) -> bool:
@@ -227,11 +152,11 @@ class Report:
         return tuple(f for f in self.findings if f.severity is Severity.ERROR)
 
     def to_dict(self) -> dict:
-        """The JSON document (plain Python types), schema :data:`REPORT_SCHEMA`."""
+        """The report as plain Python types: what the JSON profile writes (``patterns.write(x, "x.json")``,
+        with the pieces; see docs/report.md)."""
         from dataclasses import asdict
 
         return {
-            "schema": REPORT_SCHEMA,
             "pattern": self.pattern,
             "ok": self.ok,
             "units": {"length": "mm", "area": "mm2", "strain": "ratio (0.01 = 1 %)"},
@@ -244,16 +169,9 @@ class Report:
             "seams": [{**asdict(s), "panels": list(s.panels), "length_flat": list(s.length_flat),
                        "length_held": None if s.length_held is None else list(s.length_held)}
                       for s in self.seams],
+            "blanks": [b.to_dict() for b in self.blanks],
             "findings": [f.to_dict() for f in self.findings],
         }
-
-    def to_json(self, path) -> None:
-        """Write :meth:`to_dict` as JSON (atomically: a failed write leaves no file)."""
-        import json
-
-        text = json.dumps(self.to_dict(), indent=2, allow_nan=False)  # in the order shown; never a NaN
-        with atomic_output(path, what="report") as tmp:
-            tmp.write_text(text + "\n", encoding="utf-8")
 
     def __str__(self) -> str:
         lines = [f"{self.pattern}: {'ok' if self.ok else 'NOT ok'} "
@@ -282,22 +200,24 @@ class CheckOptions(Options):
                                           optional=True, metavar="F")
 
 
-def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
-    """Check a pattern before cutting: overlaps, strain, seams.
+def check(source, options: CheckOptions | None = None, **keywords) -> Report:
+    """Check a pattern or a blank before cutting: overlaps, strain, seams, a blank's faults.
 
     Never raises on geometry: every problem becomes a :class:`Finding` with
     the place it is at.
 
     Parameters
     ----------
-    pattern : patterns.Pattern
+    source : patterns.Pattern, patterns.Blank, or a list of them
+        A list gives one report of them all (a marker of several parts).
     options : CheckOptions, optional
         The limits as a record; keywords (``max_strain``: largest acceptable
         triangle strain, 0.03 = 3 %, triangles above it are reported with the
         share of area they cover -- by default the limit the pattern was
         flattened to, :attr:`Pattern.max_strain`; ``max_seam_mismatch``:
         largest acceptable difference between the two flat lengths of a seam,
-        mm) go over it.
+        mm) go over it.  A blank is exact: its findings are the unfold's
+        (flanges that collide, a bend with no flange, a meshed face).
 
     Returns
     -------
@@ -306,18 +226,45 @@ def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
     Raises
     ------
     InputError
-        Not a pattern, or a limit that is not a positive number.
+        Not a pattern or a blank, or a limit that is not a positive number.
 
     Notes
     -----
     A seam held at its length (``flatten(seams="true")``) whose flat length on
     a side is off by more than :data:`SEAM_LENGTH_TOLERANCE` is a
-    ``seam-length-not-kept`` finding: the relaxation could not keep it without
-    folding.
+    ``seam-length-not-kept`` finding, whose message names what kept it from its
+    length (folds, a relaxation stopped early, ease asked of an exact
+    development).  An exactly developed side is measured on its exact curve:
+    an isometry keeps the 3D length.
     """
-    if not isinstance(pattern, Pattern):
-        raise InputError(f"check() takes a patterns.Pattern (from patterns.flatten), got {type(pattern).__name__}")
-    opts = CheckOptions.of(options, keywords, name=pattern.name)
+    items = list(source) if isinstance(source, (list, tuple)) else [source]
+    for item in items:
+        if not isinstance(item, (Pattern, Blank)):
+            raise InputError(f"check() takes a patterns.Pattern (from patterns.flatten) or a patterns.Blank (from "
+                             f"patterns.unfold), got {type(item).__name__}")
+    if not items:
+        raise InputError("check() takes a pattern or a blank, got an empty list")
+    name = " + ".join(dict.fromkeys(item.name for item in items))
+    opts = CheckOptions.of(options, keywords, name=name)
+    reports = [_check_pattern(item, opts) if isinstance(item, Pattern) else _check_blank(item, opts) for item in items]
+    if len(reports) == 1:
+        return reports[0]
+    findings = sorted((f for r in reports for f in r.findings), key=lambda f: _ORDER[f.severity])
+    first = reports[0]
+    return Report(name, sum((r.panels for r in reports), ()), sum((r.seams for r in reports), ()), tuple(findings),
+                  first.max_strain, opts.max_seam_mismatch, opts.area_tolerance, opts.max_distortion, first.loading,
+                  sum((r.blanks for r in reports), ()))
+
+
+_ORDER = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
+
+
+def _check_blank(blank: Blank, opts: CheckOptions) -> Report:
+    return Report(blank.name, (), (), tuple(sorted(blank.findings, key=lambda f: _ORDER[f.severity])),
+                  opts.max_strain, opts.max_seam_mismatch, opts.area_tolerance, opts.max_distortion, blanks=(blank,))
+
+
+def _check_pattern(pattern: Pattern, opts: CheckOptions) -> Report:
     max_strain, max_seam_mismatch = opts.max_strain, opts.max_seam_mismatch
     if max_strain is None:
         max_strain = pattern.max_strain  # the limit the pattern was flattened (and darted) to travels with it
@@ -333,10 +280,47 @@ def check(pattern, options: CheckOptions | None = None, **keywords) -> Report:
         report, found = _seam_report(pattern, fs, max_seam_mismatch)
         seam_reports.append(report)
         findings += found
-    order = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
-    findings.sort(key=lambda f: order[f.severity])
+    findings.sort(key=lambda f: _ORDER[f.severity])
     return Report(pattern.name, tuple(panel_reports), tuple(seam_reports), tuple(findings), max_strain,
                   max_seam_mismatch, opts.area_tolerance, opts.max_distortion, pattern.model.bookkeeping)
+
+
+def _placed_like(item, drawing: Drawing):
+    """A pattern or blank moved as its first (unmirrored) pieces lie in ``drawing``."""
+    if isinstance(item, Blank):
+        kind, count = "blank", 1
+    else:
+        kind, count = "panel", len(item.panels)
+    where = {}
+    for piece in drawing.pieces:
+        s = piece.source
+        if s.kind == kind and s.part == item.name and s.copy == 0 and not piece.placement.mirrored:
+            where.setdefault(s.index, piece.placement)
+    if isinstance(item, Blank):
+        return item.moved(where.get(0, Motion()))
+    placements = []
+    for i in range(count):
+        moved = where.get(i, Motion()) @ Motion(*item.panels[i].placement)
+        placements.append((moved.angle, moved.dx, moved.dy))
+    return item.placed(placements)
+
+
+def checked_drawing(source, drawing: Drawing, options: CheckOptions | None = None) -> tuple:
+    """``(Report, Drawing)``: the check of ``source`` (a pattern, a blank or a list of them) as its pieces lie
+    in ``drawing`` -- every point and message in the drawing's frame -- and the drawing with that report
+    and each piece's findings."""
+    items = list(source) if isinstance(source, (list, tuple)) else [source]
+    placed = [_placed_like(item, drawing) for item in items]
+    report = check(placed if len(placed) > 1 else placed[0], options)
+    panel_names = {(item.name, i): flat.name for item in items if isinstance(item, Pattern)
+                   for i, flat in enumerate(item.panels)}
+    pieces = []
+    for piece in drawing.pieces:
+        s = piece.source
+        about = panel_names.get((s.part, s.index)) if s.kind == "panel" else s.part
+        first = s.copy == 0 and not piece.placement.mirrored
+        pieces.append(replace(piece, findings=tuple(f for f in report.findings if first and about in f.panels)))
+    return report, replace(drawing, pieces=tuple(pieces), report=report.to_dict())
 
 
 GROSS_SHARE = 0.01
@@ -430,7 +414,7 @@ def _seam_report(pattern, fs, max_seam_mismatch):
     seam = fs.seam
     names = tuple(pattern.panels[p].name for p in seam.panels)
     pct = 100.0 * fs.mismatch / seam.length if seam.length > 0 else 0.0
-    held = None if fs.held_lengths is None else tuple(float(x) for x in fs.held_lengths)
+    held = None if fs.held_lengths is None else tuple(None if x is None else float(x) for x in fs.held_lengths)
     report = SeamReport(seam.id, names, seam.cad_edge, float(seam.length), seam.polyline_length,
                         tuple(float(x) for x in fs.flat_lengths), held, fs.mismatch, pct)
     findings = []
@@ -443,15 +427,26 @@ def _seam_report(pattern, fs, max_seam_mismatch):
                      f"(limit {max_seam_mismatch:g} mm)"))
     if held is not None:
         off = [(side, fs.flat_lengths[side], held[side]) for side in range(2)
-               if abs(fs.flat_lengths[side] / held[side] - 1.0) > SEAM_LENGTH_TOLERANCE]
+               if held[side] is not None and abs(fs.flat_lengths[side] / held[side] - 1.0) > SEAM_LENGTH_TOLERANCE]
         if off:
             side, got, want = max(off, key=lambda x: abs(x[1] / x[2] - 1.0))
+            cause = _why_not_kept(pattern.panels[seam.panels[side]].flattening)
             findings.append(Finding(
                 Code.SEAM_LENGTH_NOT_KEPT, Severity.LIMIT, names, mid[None, :], (), seam.id,
-                f"seam {seam.id} ({names[0]} / {names[1]}): could not be held at its length "
-                f"(folds in the way, or the relaxation stopped early): "
+                f"seam {seam.id} ({names[0]} / {names[1]}): could not be held at its length ({cause}): "
                 f"{got:.2f} mm flat on {names[side]}'s side, {want:.2f} mm wanted ({100 * (got / want - 1):+.2f} %)"))
     return report, findings
+
+
+def _why_not_kept(flattening) -> str:
+    """What kept a held seam side from its length, as far as its panel's flattening says."""
+    if flattening.n_folded:
+        return f"{flattening.n_folded} folded triangles in the panel stood in the way"
+    if not flattening.converged:
+        return (f"the relaxation stopped after {flattening.iterations} iterations, before the held lengths were "
+                f"reached: give max_iterations more")
+    return (f"the relaxation held each edge within {flattening.length_error:.2%} only: the held lengths pull "
+            f"against the panel's other constraints (pins, darts, min_stretch)")
 
 
 def _panel_overlaps(flat) -> list:

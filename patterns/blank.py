@@ -1,102 +1,27 @@
 """The flat blank of a bent sheet-metal part: one outline, its holes, its bend lines.
 
 :func:`patterns.unfold` returns a :class:`Blank`.  Its outline and holes are
-loops of exact pieces (:class:`Line`, :class:`Arc`, :class:`Polyline`) so that a
-drilled hole stays a circle in the DXF; :meth:`Loop.points` samples them for
-areas and drawings.  Millimetres throughout.
+loops of exact pieces (:class:`~patterns.curves.Line`,
+:class:`~patterns.curves.Arc`, :class:`~patterns.curves.Polyline`) so that a
+drilled hole stays a circle in the DXF; :meth:`~patterns.curves.Loop.points`
+samples them for areas and drawings.  Millimetres throughout.  A blank is what
+is cut: :func:`patterns.pieces.piece_of` turns it into a
+:class:`~patterns.pieces.Piece`, which every writer, the nester and the
+report take (``patterns.write(blank, "bracket.dxf")``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from enum import Enum
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
 import shapely
 
-__all__ = ["Arc", "Bend", "Blank", "BlankCode", "BlankFinding", "Line", "Loop", "Polyline"]
+from .curves import Loop, Motion
+from .findings import Finding, Severity
 
-
-@dataclass(frozen=True, eq=False)
-class Line:
-    """A straight piece from ``start`` to ``end``: (2,) float64, mm."""
-
-    start: np.ndarray
-    end: np.ndarray
-
-    def points(self, tolerance: float) -> np.ndarray:
-        """(2, 2) float64: its two ends."""
-        return np.array([self.start, self.end])
-
-
-@dataclass(frozen=True, eq=False)
-class Arc:
-    """A circular arc about ``center`` ((2,) float64, mm) of ``radius`` mm, from angle
-    ``start`` through ``sweep`` (radians; positive counter-clockwise; 2 pi for a circle)."""
-
-    center: np.ndarray
-    radius: float
-    start: float
-    sweep: float
-
-    @property
-    def is_circle(self) -> bool:
-        return abs(abs(self.sweep) - 2 * np.pi) < 1e-9
-
-    def points(self, tolerance: float) -> np.ndarray:
-        """(k, 2) float64: the arc sampled so that no chord is farther than ``tolerance`` mm from it."""
-        step = 2 * np.arccos(max(1 - tolerance / self.radius, -1.0)) if self.radius > tolerance else np.pi / 2
-        n = max(2, int(np.ceil(abs(self.sweep) / max(step, 1e-6))) + 1)
-        a = self.start + np.linspace(0.0, self.sweep, n)
-        return self.center + self.radius * np.column_stack([np.cos(a), np.sin(a)])
-
-
-@dataclass(frozen=True, eq=False)
-class Polyline:
-    """A piece with no simpler exact form, sampled finely: (k, 2) float64, mm."""
-
-    vertices: np.ndarray
-
-    def points(self, tolerance: float) -> np.ndarray:
-        return self.vertices
-
-
-@dataclass(frozen=True, eq=False)
-class Loop:
-    """A closed contour: its pieces in order, each starting where the one before ends."""
-
-    pieces: tuple
-
-    def points(self, tolerance: float = 0.001) -> np.ndarray:
-        """(k, 2) float64, mm: the contour sampled (chord error at most ``tolerance`` mm), not closed."""
-        parts = [p.points(tolerance)[:-1] for p in self.pieces]
-        return np.concatenate(parts) if parts else np.zeros((0, 2))
-
-    @cached_property
-    def polygon(self) -> shapely.Polygon:
-        return shapely.Polygon(self.points())
-
-    @property
-    def area(self) -> float:
-        """Enclosed area, mm² (positive)."""
-        return float(self.polygon.area)
-
-    @property
-    def length(self) -> float:
-        """Length of the contour, mm (arcs exactly)."""
-        total = 0.0
-        for p in self.pieces:
-            if isinstance(p, Arc):
-                total += p.radius * abs(p.sweep)
-            else:
-                pts = p.points(0.001)
-                total += float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
-        return total
-
-    @property
-    def is_circle(self) -> bool:
-        return len(self.pieces) == 1 and isinstance(self.pieces[0], Arc) and self.pieces[0].is_circle
+__all__ = ["Bend", "Blank"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,6 +44,8 @@ class Bend:
         from the bend table.
     faces : tuple of int
         The CAD faces of the bend (cylinders of the developed skin), ``shape.faces()`` indices.
+    k_factor : float or None
+        The K-factor the bend was developed with; None when a bend table gave it.
     """
 
     line: np.ndarray
@@ -127,44 +54,20 @@ class Bend:
     direction: str
     allowance: float
     faces: tuple
+    k_factor: float | None = None
+
+    def __post_init__(self):
+        line = np.array(self.line, dtype=np.float64).reshape(2, 2)
+        line.setflags(write=False)
+        object.__setattr__(self, "line", line)
 
     @property
     def label(self) -> str:
         """What the drawing says at the line: ``UP 90.0° R2.4``."""
         return f"{self.direction.upper()} {self.angle:.1f}° R{self.inside_radius:g}"
 
-
-class BlankCode(str, Enum):
-    """What a :class:`BlankFinding` is about (also its JSON ``code``)."""
-
-    FLANGES_OVERLAP = "flanges-overlap"
-    BEND_WITHOUT_FLANGE = "bend-without-flange"
-    MESHED_FACE = "meshed-face"
-
-
-@dataclass(frozen=True, eq=False)
-class BlankFinding:
-    """A fault of a blank a shop must know about.
-
-    Attributes
-    ----------
-    code : BlankCode
-    error : bool
-        True: the blank cannot be cut as it is (it is not written as DXF); False: a warning.
-    message : str
-        One line, starting with the part's name.
-    point : (2,) float64, mm
-        Where on the blank.
-    """
-
-    code: BlankCode
-    error: bool
-    message: str
-    point: np.ndarray
-
-    def to_dict(self) -> dict:
-        return {"code": self.code.value, "severity": "error" if self.error else "warning",
-                "message": self.message, "point": [round(float(x), 4) for x in self.point]}
+    def moved(self, motion: Motion) -> Bend:
+        return replace(self, line=motion(self.line))
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,10 +77,10 @@ class Blank:
     Attributes
     ----------
     name : str
-    outline : Loop
+    outline : patterns.curves.Loop
         The outer contour, counter-clockwise.
-    holes : tuple of Loop
-        Every hole and cut-out, clockwise; drilled holes as one full-circle :class:`Arc`.
+    holes : tuple of patterns.curves.Loop
+        Every hole and cut-out, clockwise; drilled holes as one full-circle :class:`~patterns.curves.Arc`.
     bends : tuple of Bend
     thickness : float
         Sheet thickness read from the model, mm.
@@ -185,7 +88,9 @@ class Blank:
         The K-factor the bends were developed with (None when a bend table gave every bend).
     fixed_face : int
         The CAD face that keeps its place (``shape.faces()`` index).
-    findings : tuple of BlankFinding
+    findings : tuple of patterns.Finding
+        Errors (``flanges-overlap``: the blank cannot be cut as it is) and notes
+        (``bend-without-flange``, ``meshed-face``), as :func:`patterns.check` reports them.
     """
 
     name: str
@@ -200,7 +105,7 @@ class Blank:
     @property
     def ok(self) -> bool:
         """No finding that stops the blank being cut."""
-        return not any(f.error for f in self.findings)
+        return not any(f.severity is Severity.ERROR for f in self.findings)
 
     @cached_property
     def polygon(self) -> shapely.Polygon:
@@ -229,8 +134,15 @@ class Blank:
         w, h = self.size
         return self.area / (w * h) if w * h > 0 else 0.0
 
+    def moved(self, motion: Motion) -> Blank:
+        """The blank moved rigidly (as laid out in a drawing or nested): outline, holes, bend lines and the
+        findings' points; nothing is scaled."""
+        findings: tuple[Finding, ...] = tuple(f.moved(motion) for f in self.findings)
+        return replace(self, outline=self.outline.moved(motion), holes=tuple(h.moved(motion) for h in self.holes),
+                       bends=tuple(b.moved(motion) for b in self.bends), findings=findings)
+
     def to_dict(self) -> dict:
-        """The report: size, area, usage, bends and findings, JSON-ready."""
+        """Size, area, usage, bends and findings, JSON-ready (the report's ``blanks`` entries)."""
         w, h = self.size
         return {
             "name": self.name, "ok": self.ok, "thickness_mm": round(self.thickness, 4),
@@ -239,23 +151,7 @@ class Blank:
             "outer_perimeter_mm": round(self.perimeter, 3), "holes": len(self.holes),
             "usage": round(self.usage, 4),
             "bends": [{"angle_deg": round(b.angle, 3), "inside_radius_mm": round(b.inside_radius, 4),
-                       "direction": b.direction, "allowance_mm": round(b.allowance, 4),
+                       "direction": b.direction, "allowance_mm": round(b.allowance, 4), "k_factor": b.k_factor,
                        "line": np.round(b.line, 4).tolist(), "faces": list(b.faces)} for b in self.bends],
             "findings": [f.to_dict() for f in self.findings],
         }
-
-    def to_json(self, path, *, extra: dict | None = None) -> None:
-        """Write :meth:`to_dict` (and ``extra`` entries) as JSON, atomically."""
-        import json
-
-        from .files import atomic_output
-
-        text = json.dumps({**self.to_dict(), **(extra or {})}, indent=2, allow_nan=False)
-        with atomic_output(path, what="report") as tmp:
-            tmp.write_text(text + "\n", encoding="utf-8")
-
-    def to_dxf(self, path, **options) -> None:
-        """Write the blank as a DXF for a laser or plasma cutter (see :func:`patterns.export.sheet.write_blank_dxf`)."""
-        from .export.sheet import write_blank_dxf
-
-        write_blank_dxf(self, path, **options)

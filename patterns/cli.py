@@ -9,8 +9,9 @@ Subcommands::
     patterns info INPUT
     patterns demo [-o DIR]
     patterns batch DIR -o OUTDIR [--jobs N] [--scheduler ADDRESS] [--timeout S] [--report] [--preview]
+                   [--unfold [--k-factor K | --bend-table CSV]]
     patterns unfold PART.STEP -o BLANK.dxf [--k-factor K] [--bend-table CSV] [--fixed-face N]
-                    [--report OUT.json] [--compare THEIRS.dxf]
+                    [--report OUT.json] [--compare THEIRS.dxf] [--sheet LxW --copies N] [--layer-map MAP]
 
 Every run plans, then works, then commits: every option, the input and every
 output are checked before any work (one line, exit 2, nothing written); the
@@ -89,21 +90,23 @@ def _parser() -> argparse.ArgumentParser:
     from . import __version__
     from .audit import CheckOptions
     from .batching import BatchOptions
-    from .export.dxf import DxfOptions
+    from .export import WriteOptions
     from .flattening import FlattenOptions
-    from .flattening.sheetmetal import UnfoldOptions
     from .nesting import NestOptions
     from .options import add_arguments
+    from .pieces import PieceOptions
     from .reading import LoadOptions
+    from .sheetmetal import UnfoldOptions
 
     parser = _Parser(prog="patterns",
-                     description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns.")
+                     description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns, and unfold "
+                                 "bent sheet-metal parts into blanks.")
     parser.add_argument("--version", action="version", version=f"patterns {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors (anywhere on the line)")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
 
     # Every option flag below is made from the records the API validates with
-    # (patterns.options): a new option there is a new flag here, in flatten and batch alike.
+    # (patterns.options): a new option there is a new flag here, in flatten, unfold and batch alike.
     def loading(p, *, positional=True):
         if positional:
             p.add_argument("input", type=Path,
@@ -117,17 +120,18 @@ def _parser() -> argparse.ArgumentParser:
         group = p.add_argument_group("checking")
         add_arguments(group, CheckOptions)
         if report:
-            group.add_argument("--report", type=Path, default=None, help="write the JSON report here")
+            group.add_argument("--report", type=Path, default=None,
+                               help="write the JSON report here (the check and every piece, in the DXF's frame)")
 
-    def output(p):
-        group = p.add_argument_group("DXF output")
-        add_arguments(group, DxfOptions, skip=("units",))  # --units: one flag with loading's
-        # the margin around each piece is the largest seam allowance
-        add_arguments(p.add_argument_group("nesting (sparrow)"), NestOptions, skip=("margin",))
+    def output(p, *, blank=False):
+        add_arguments(p.add_argument_group("pieces"), PieceOptions, skip=_PATTERN_ONLY if blank else ())
+        add_arguments(p.add_argument_group("output"), WriteOptions, skip=() if blank else ("units",))
+        add_arguments(p.add_argument_group("nesting (sparrow)"), NestOptions)
 
-    flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, or .obj for one panel)")
+    flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, .svg, or .obj for one panel)")
     flat.add_argument("-o", "--output", type=Path, required=True,
-                      help="output: .dxf (the pattern for a cutter) or .obj (the flat mesh of a one-panel part)")
+                      help="output: .dxf (the pattern for a cutter), .svg (1:1 for laser and vinyl cutters) or .obj "
+                           "(the flat mesh of a one-panel part)")
     flat.add_argument("--preview", type=Path, default=None, help="render the written DXF at 1:1 (.png or .svg)")
     flat.add_argument("--heat-map", type=Path, default=None, help="strain heat map (.png or .svg)")
     loading(flat)
@@ -147,44 +151,61 @@ def _parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", help="run the whole pipeline on a bundled sample into ./patterns-demo/")
     demo.add_argument("-o", "--output", type=Path, default=Path("patterns-demo"), help="folder (default ./patterns-demo)")
 
-    unf = sub.add_parser("unfold", help="unfold a bent sheet-metal part into one flat blank with bend lines (.dxf)")
+    unf = sub.add_parser("unfold", help="unfold a bent sheet-metal part into one flat blank with bend lines (.dxf, "
+                                        ".svg)")
     unf.add_argument("input", type=Path, help="the folded solid: CAD file (.step .stp .brep .iges .igs)")
-    unf.add_argument("-o", "--output", type=Path, required=True, help="the blank, .dxf (CUT, BEND, LABEL layers)")
+    unf.add_argument("-o", "--output", type=Path, required=True,
+                     help="the blank: .dxf (outline, holes, bend lines, labels) or .svg")
     add_arguments(unf.add_argument_group("unfolding"), UnfoldOptions)
-    unf.add_argument("--report", type=Path, default=None, help="write the JSON report here (bends, size, usage)")
+    unf.add_argument("--report", type=Path, default=None,
+                     help="write the JSON report here (bends, size, usage, the blank as drawn, in the DXF's frame)")
+    unf.add_argument("--preview", type=Path, default=None, help="render the written DXF at 1:1 (.png or .svg)")
     unf.add_argument("--compare", type=Path, default=None, metavar="DXF",
                      help="a flat pattern of the same part from another CAD program: print how far ours lies from it")
+    output(unf, blank=True)
 
-    batch = sub.add_parser("batch", help="flatten every CAD and mesh file in a folder, in parallel")
+    batch = sub.add_parser("batch", help="flatten (or --unfold) every part in a folder, in parallel")
     batch.add_argument("folder", type=Path, help="folder of input files (not searched recursively)")
     batch.add_argument("-o", "--output", type=Path, required=True, help="folder for the patterns and reports")
     add_arguments(batch.add_argument_group("running"), BatchOptions)
     loading(batch, positional=False)
     flattening(batch)
+    add_arguments(batch.add_argument_group("unfolding (with --unfold)"), UnfoldOptions)
     checking(batch, report=False)
     output(batch)
     return parser
 
 
+_PATTERN_ONLY = ("seam_allowance", "seam_corners", "notch_spacing", "notch_style", "bend_spacing", "arcs",
+                 "arc_tolerance", "strain_layer")
+"""Piece options that only a flattened pattern has (seams, rulings, fitted arcs, strain)."""
+
+
 def _records(args, name=None):
-    """The option records (load, flatten, check, DXF) from parsed flags: each value checked as the API checks it."""
+    """The option records from parsed flags, each value checked as the API checks it: ``load``, ``flatten``
+    (flatten, check, batch), ``unfold`` (unfold, batch --unfold), ``check``, ``pieces``, ``write``, ``nest``."""
     from .audit import CheckOptions
-    from .export.dxf import DxfOptions
+    from .export import WriteOptions
     from .flattening import FlattenOptions
+    from .nesting import NestOptions
     from .options import from_arguments
+    from .pieces import PieceOptions
     from .reading import LoadOptions
+    from .sheetmetal import UnfoldOptions
 
-    records = {"load": from_arguments(LoadOptions, args, name=name)}
-    if hasattr(args, "method"):
+    unfolding = args.command == "unfold" or (args.command == "batch" and args.unfold)
+    if args.command == "info":
+        return {"load": from_arguments(LoadOptions, args, name=name)}
+    records = {}
+    if unfolding:
+        records["unfold"] = from_arguments(UnfoldOptions, args, name=name)  # the bend table read and checked
+    else:
+        records["load"] = from_arguments(LoadOptions, args, name=name)
         records["flatten"] = from_arguments(FlattenOptions, args, name=name)
-        records["check"] = from_arguments(CheckOptions, args, name=name)
-    if hasattr(args, "profile"):
-        from .nesting import NestOptions
-
-        records["dxf"] = from_arguments(DxfOptions, args, name=name)
-        allowance = records["dxf"].seam_allowance
-        margin = max(allowance.values(), default=0.0) if isinstance(allowance, dict) else allowance
-        records["nest"] = from_arguments(NestOptions, args, name=name, margin=margin)
+    records["check"] = from_arguments(CheckOptions, args, name=name)
+    records["pieces"] = from_arguments(PieceOptions, args, name=name)
+    records["write"] = from_arguments(WriteOptions, args, name=name)
+    records["nest"] = from_arguments(NestOptions, args, name=name)
     return records
 
 
@@ -232,13 +253,15 @@ def _loaded(model, seconds):
 def _wrote(result, records):
     for kind, path in result.outputs.items():
         if kind == "pattern" and path.suffix.lower() == ".dxf":
-            dxf = records["dxf"]
-            print(f"wrote {path} ({dxf.profile} profile, {dxf.units})")
-            if dxf.units in ("cm", "m"):
-                print(f"note: {path} is in {dxf.units}: Inkscape's DXF import and dxf2gcode read only mm and inches, "
+            opts = records["write"]
+            print(f"wrote {path} ({opts.profile or 'machine'} profile, {opts.units}, layers {opts.layer_map})")
+            if opts.units in ("cm", "m"):
+                print(f"note: {path} is in {opts.units}: Inkscape's DXF import and dxf2gcode read only mm and inches, "
                       f"and take it for mm; write mm or in for them")
+        elif kind == "pattern" and path.suffix.lower() == ".svg":
+            print(f"wrote {path} (1:1 in mm: red cut, blue score, black engrave)")
         elif kind == "pattern":
-            print(f"wrote {path} (flat mesh, z = 0, in {records['dxf'].units})")
+            print(f"wrote {path} (flat mesh, z = 0, in {records['write'].units})")
         elif kind == "preview" and result.part.preview_dpi is not None and path.suffix.lower() == ".png":
             dpi = result.part.preview_dpi
             print(f"wrote {path} (the DXF at 1:1 at {dpi:.3g} dpi"
@@ -264,13 +287,14 @@ class _Run:
 def _run_part(args, outputs: dict, records: dict):
     """Plan the outputs, then flatten the part and write them all, or none."""
     from .files import Outputs
-    from .jobs import flatten_part, plan_outputs
+    from .jobs import flatten_part, inputs_of, plan_outputs
     from .reading import check_source
 
     check_source(args.input)
-    planned = plan_outputs(outputs, inputs=[args.input])
+    inputs = inputs_of(args.input, records)
+    planned = plan_outputs(outputs, inputs=inputs, profile=records["write"].profile)
     progress = Progress("flattening")
-    with Outputs(inputs=[args.input]) as out:
+    with Outputs(inputs=inputs) as out:
         try:
             part = flatten_part(args.input, records, outputs=planned, stage=out.stage, progress=progress,
                                 loaded=_loaded)
@@ -337,10 +361,11 @@ def _cmd_demo(args) -> int:
 
     from build123d import export_step
 
-    from .audit import check
-    from .export.preview import preview_dxf
+    from .audit import CheckOptions, checked_drawing
+    from .export import heat_map, preview_dxf, write
     from .files import Outputs, output_target
     from .flattening import flatten
+    from .pieces import drawing_of
     from .reading import load
     from .samples import cup
 
@@ -360,12 +385,13 @@ def _cmd_demo(args) -> int:
             export_step(cup(), step)
             model = replace(load(step), name="cup.step")  # read from its temporary name
             pattern = flatten(model)
-            report = check(pattern, max_strain=0.05)
+            drawing = drawing_of(pattern, seam_allowance=10.0)
+            report, checked = checked_drawing(pattern, drawing, CheckOptions(max_strain=0.05))
             dxf = files.stage(out / "cup.dxf", what="DXF file")
-            pattern.to_dxf(dxf, seam_allowance=10.0)
-            pattern.to_dxf(files.stage(out / "cup_astm.dxf", what="DXF file"), profile="astm", seam_allowance=10.0)
-            report.to_json(files.stage(out / "cup.json", what="report"))
-            pattern.heat_map(files.stage(out / "cup_heatmap.png", what="heat map"))
+            write(drawing, dxf)
+            write(drawing, files.stage(out / "cup_astm.dxf", what="DXF file"), profile="astm")
+            write(checked, files.stage(out / "cup.json", what="report"))
+            heat_map(pattern, files.stage(out / "cup_heatmap.png", what="heat map"))
             preview_dxf(dxf, files.stage(out / "cup_preview.png", what="preview"))
             files.commit()
     except BaseException:
@@ -389,7 +415,7 @@ def _cmd_batch(args) -> int:
 
     records = _records(args)  # every option checked before any file is read
     options = from_arguments(BatchOptions, args)
-    files, _ = plan_batch(args.folder, args.output)
+    files, _ = plan_batch(args.folder, args.output, unfold=options.unfold)
     progress = _BatchProgress(len(files), quiet=options.quiet)
     result = batch(files, args.output, records=records, options=options, on_row=progress.row,
                    on_start=progress.start)
@@ -454,64 +480,46 @@ class _BatchProgress:
 
 
 def _cmd_unfold(args) -> int:
-    from .comparison import compare_blank, read_flat_pattern
-    from .files import Outputs, check_input_file, output_target
-    from .flattening.sheetmetal import UnfoldOptions, unfold
-    from .options import from_arguments
+    from .comparison import read_flat_pattern
+    from .files import Outputs, check_input_file
+    from .jobs import inputs_of, plan_outputs, unfold_part
     from .reading import CAD_SUFFIXES, check_source
 
-    options = from_arguments(UnfoldOptions, args, name=os.fsdecode(args.input))  # the bend table read and checked
+    records = _records(args, name=os.fsdecode(args.input))  # the bend table read and checked
     check_source(args.input, CAD_SUFFIXES)
-    if args.output.suffix.lower() != ".dxf":
-        raise InputError(f"{args.output}: unfold writes a .dxf blank")
-    if args.report is not None and args.report.suffix.lower() != ".json":
-        raise InputError(f"{args.report}: --report writes .json")
-    inputs = [args.input] + ([args.compare] if args.compare is not None else [])
+    inputs = inputs_of(args.input, records) + ([args.compare] if args.compare is not None else [])
     if args.compare is not None:
         check_input_file(args.compare, what="DXF file")
-    outputs = [(args.output, "DXF file")] + ([(args.report, "report")] if args.report is not None else [])
-    for path, what in outputs:
-        output_target(path, what=what, inputs=inputs, error=InputError)
-    if args.report is not None and output_target(args.report, error=InputError) == output_target(args.output,
-                                                                                                  error=InputError):
-        raise InputError(f"{args.report}: the report and the blank cannot be the same file")
+    planned = plan_outputs({"pattern": args.output, "report": args.report, "preview": args.preview}, inputs=inputs,
+                           suffixes={"pattern": (".dxf", ".svg")}, profile=records["write"].profile)
     reference = read_flat_pattern(args.compare) if args.compare is not None else None
-    start = time.perf_counter()
-    blank = unfold(args.input, options)
-    seconds = time.perf_counter() - start
+    with Outputs(inputs=inputs) as out:
+        part = unfold_part(args.input, records, outputs=planned, stage=out.stage, reference=reference)
+        if part.subject.ok:
+            out.commit()
+    blank = part.subject
     w, h = blank.size
     print(f"{blank.name}: sheet {blank.thickness:g} mm, {len(blank.bends)} bends, {len(blank.holes)} holes; "
           f"blank {w:.2f} x {h:.2f} mm, area {blank.area:.1f} mm2, usage {blank.usage:.1%} (unfolded in "
-          f"{seconds:.2f} s)")
+          f"{part.seconds['flatten']:.2f} s)")
     rows = [("bend", "direction", "angle deg", "inside R mm", "allowance mm")]
     rows += [(str(k), b.direction, f"{b.angle:.2f}", f"{b.inside_radius:g}", f"{b.allowance:.4f}")
              for k, b in enumerate(blank.bends)]
     if blank.bends:
         _table(rows)
     for f in blank.findings:
-        print(f"  {'error' if f.error else 'warning'}: {f.message}")
-    extra = {}
-    if reference is not None:
-        c = compare_blank(blank, reference)
+        print(f"  {f.severity.value}: {f.message}")
+    c = part.comparison
+    if c is not None:
         print(f"against {args.compare}: area {c.area_error:+.4%}, outer perimeter {c.perimeter - c.perimeter_reference:+.3f}"
               f" mm, holes {c.holes}/{c.holes_reference}, bend lines {c.bend_lines}/{c.bend_lines_reference}, outline "
               f"Hausdorff {c.hausdorff:.3f} mm ({c.within:.1%} of it within 0.1 mm)")
-        extra["comparison"] = {"reference": os.fsdecode(args.compare), "area_error": c.area_error,
-                               "perimeter_mm": c.perimeter, "perimeter_reference_mm": c.perimeter_reference,
-                               "holes_reference": c.holes_reference, "bend_lines_reference": c.bend_lines_reference,
-                               "hausdorff_mm": c.hausdorff, "hausdorff_all_mm": c.hausdorff_all,
-                               "within_0.1mm": c.within, "mirrored": c.mirrored}
     if not blank.ok:
         print(f"{args.output}: not written (the blank cannot be cut as it is)")
         return EXIT_CHECK
-    with Outputs(inputs=inputs) as files:
-        blank.to_dxf(files.stage(args.output, what="DXF file"))
-        if args.report is not None:
-            blank.to_json(files.stage(args.report, what="report"), extra=extra)
-        files.commit()
-    print(f"wrote {args.output}")
-    if args.report is not None:
-        print(f"wrote {args.report}")
+    if part.nest is not None:
+        print(f"nested on {part.nest} (sparrow, {part.nest.seconds:.1f} s)")
+    _wrote(_Run(planned, part), records)
     return EXIT_OK
 
 

@@ -12,6 +12,7 @@ other (Hausdorff distance).
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,6 +42,8 @@ class FlatPattern:
     outline: np.ndarray
     holes: tuple
     bend_lines: np.ndarray
+    path: str = ""
+    """The file it was read from."""
 
     @property
     def polygon(self) -> shapely.Polygon:
@@ -118,7 +121,7 @@ def read_flat_pattern(path, *, tolerance: float = 0.001) -> FlatPattern:
     outline = np.array(shapely.geometry.polygon.orient(polys[outer], 1.0).exterior.coords)[:-1]
     holes = tuple(np.array(shapely.geometry.polygon.orient(p, 1.0).exterior.coords)[-2::-1]
                   for k, p in enumerate(polys) if k != outer)
-    return FlatPattern(outline, holes, np.array(bends).reshape(-1, 2, 2))
+    return FlatPattern(outline, holes, np.array(bends).reshape(-1, 2, 2), os.fsdecode(path))
 
 
 def _chain(pieces, path):
@@ -191,6 +194,13 @@ class BlankComparison:
     def area_error(self) -> float:
         """Relative area difference (ours less theirs, over theirs)."""
         return (self.area - self.area_reference) / self.area_reference
+
+    def to_dict(self, reference: str = "") -> dict:
+        """The report's ``comparison`` entry (mm, ratios)."""
+        return {"reference": reference, "area_error": self.area_error, "perimeter_mm": self.perimeter,
+                "perimeter_reference_mm": self.perimeter_reference, "holes_reference": self.holes_reference,
+                "bend_lines_reference": self.bend_lines_reference, "hausdorff_mm": self.hausdorff,
+                "hausdorff_all_mm": self.hausdorff_all, "within_0.1mm": self.within, "mirrored": self.mirrored}
 
 
 def _resample(loop: np.ndarray, step: float) -> np.ndarray:

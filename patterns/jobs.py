@@ -1,39 +1,56 @@
 """One part through the whole pipeline, as one run: checked before any work, written all at once.
 
-A run of ``patterns flatten`` (or one file of ``patterns batch``) goes in three
-steps, so that a refused run writes nothing and no run destroys a file it was
-not asked to write:
+A run of ``patterns flatten`` or ``patterns unfold`` (or one file of
+``patterns batch``) goes in three steps, so that a refused run writes nothing
+and no run destroys a file it was not asked to write:
 
 1. **plan** -- before the input is read: every option checked by its
    declaration (the records of :mod:`patterns.options`), the input checked
    (a readable regular file of a known type), every output checked
    (:func:`plan_outputs`: its kind's suffix, a writable folder, not a folder
-   or a device, not the input, not another output);
-2. **work** -- :func:`flatten_part`: load, the checks that need the part
-   (:func:`check_part`: a one-panel part for a flat OBJ, the notch and bend
-   counts the spacing options would draw), flatten, nest, check, and every
-   output written to the place ``stage`` gives (temporary files);
+   or a device, not an input -- the part, a bend table, a flat pattern to
+   compare with -- not another output);
+2. **work** -- :func:`flatten_part` or :func:`unfold_part`: load, the checks
+   that need the part (:func:`check_part`), flatten or unfold, make the
+   pieces, nest them, check, and write every output to the place ``stage``
+   gives (temporary files);
 3. **commit** -- the caller renames them all onto their targets
    (:class:`patterns.files.Outputs`), or removes them all.
+
+Patterns and blanks go the same way from the pieces on: one drawing
+(:class:`patterns.pieces.Drawing`), one check report in its frame, one set of
+writers.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from .audit import Report, check, checked_drawing
+from .blank import Blank
+from .comparison import BlankComparison, FlatPattern, compare_blank
 from .errors import InputError
+from .export import heat_map, preview_dxf, write, write_flat_obj
+from .export.registry import profile_for
 from .files import output_target
+from .flattening import flatten
+from .model import Model
+from .nesting import Layout, layout
+from .pattern import Pattern
+from .pieces import Drawing, check_marks, drawing_of
+from .reading import load
+from .sheetmetal import unfold
 from .units import Unit
 
-__all__ = ["OUTPUT_KINDS", "PartResult", "check_part", "flatten_part", "plan_outputs"]
+__all__ = ["OUTPUT_KINDS", "PartResult", "check_part", "flatten_part", "plan_outputs", "unfold_part"]
 
 OUTPUT_KINDS = {
-    "pattern": ((".dxf", ".obj"), "pattern"),
+    "pattern": ((".dxf", ".svg", ".obj"), "pattern"),
     "report": ((".json",), "report"),
     "heat_map": ((".png", ".svg"), "heat map"),
     "preview": ((".png", ".svg"), "preview"),
@@ -42,8 +59,20 @@ OUTPUT_KINDS = {
 
 _FLAGS = {"pattern": "-o", "report": "--report", "heat_map": "--heat-map", "preview": "--preview"}
 
+_DXF = ("machine", "astm")
+"""Profiles that only choose the DXF's dialect: with another output suffix they are not asked for."""
 
-def plan_outputs(outputs: dict, *, inputs=()) -> dict:
+
+def inputs_of(source, records: dict) -> list:
+    """Every file a run reads: the part, and a bend table when one is given (no output may name them)."""
+    out = [Path(source)]
+    unfolding = records.get("unfold")
+    if unfolding is not None and unfolding.bend_table is not None:
+        out.append(Path(unfolding.bend_table.path))
+    return out
+
+
+def plan_outputs(outputs: dict, *, inputs=(), suffixes: dict | None = None, profile: str | None = None) -> dict:
     """The run's outputs checked before any work: ``{kind: Path}`` (kinds given None left out).
 
     Parameters
@@ -51,7 +80,11 @@ def plan_outputs(outputs: dict, *, inputs=()) -> dict:
     outputs : dict
         ``{kind: path or None}``, kinds of :data:`OUTPUT_KINDS`.
     inputs : iterable of path
-        The run's inputs, which no output may name.
+        The run's inputs (the part, a bend table, a file compared with), which no output may name.
+    suffixes : dict, optional
+        ``{kind: suffixes}`` narrower than :data:`OUTPUT_KINDS` (a blank has no flat mesh).
+    profile : str, optional
+        The profile asked for the pattern (``--profile``): it must write the pattern's suffix.
 
     Raises
     ------
@@ -64,79 +97,122 @@ def plan_outputs(outputs: dict, *, inputs=()) -> dict:
     for kind, path in outputs.items():
         if path is None:
             continue
-        suffixes, what = OUTPUT_KINDS[kind]
+        allowed, what = OUTPUT_KINDS[kind]
+        allowed = (suffixes or {}).get(kind, allowed)
         path = Path(path)
-        if path.suffix.lower() not in suffixes:
-            raise InputError(f"{path}: {_FLAGS[kind]} writes {' or '.join(suffixes)}, not "
-                             f"{path.suffix.lower() or '(no suffix)'!r}")
+        if path.suffix.lower() not in allowed:
+            said = " or ".join(allowed) if len(allowed) < 3 else f"{', '.join(allowed[:-1])} or {allowed[-1]}"
+            raise InputError(f"{path}: {_FLAGS[kind]} writes {said}, not {path.suffix.lower() or '(no suffix)'!r}")
         target = output_target(path, what=what, inputs=inputs, error=InputError)
         for other_kind, other in planned.items():
             if output_target(other, what=what, error=InputError) == target:
                 raise InputError(f"{path}: given twice, as {_FLAGS[other_kind]} and {_FLAGS[kind]}; "
                                  f"name two files")
         planned[kind] = path
+    pattern = planned.get("pattern")
+    if pattern is not None and pattern.suffix.lower() != ".obj":
+        profile_for(pattern, profile if pattern.suffix.lower() == ".dxf" or profile not in _DXF else None)
     if "preview" in planned and ("pattern" not in planned or planned["pattern"].suffix.lower() != ".dxf"):
         raise InputError(f"{planned['preview']}: --preview renders the DXF file; write the pattern as .dxf")
     return planned
 
 
-def check_part(model, records: dict, outputs: dict) -> None:
+def check_part(model: Model, records: dict, outputs: dict) -> None:
     """The checks that need the part but come before flattening it (InputError, in well under a second).
 
     A flat OBJ holds one panel; ``notch_spacing`` and ``bend_spacing`` must not
-    ask for more marks than :data:`patterns.export.dxf.MAX_MARKS` on this part
+    ask for more marks than :data:`patterns.pieces.options.MAX_MARKS` on this part
     (its seams' 3D lengths, its panels' sizes).
     """
-    from .export.dxf import check_marks
-
     pattern_path = outputs.get("pattern")
     if pattern_path is not None and pattern_path.suffix.lower() == ".obj" and len(model.panels) != 1:
         raise InputError(f"{model.name}: {len(model.panels)} panels; a flat .obj holds one, write a .dxf")
-    if "dxf" in records:
+    if "pieces" in records:
         check_marks(model.name, [s.length for s in model.seams],
-                    [float(np.ptp(p.vertices, axis=0).max()) for p in model.panels], records["dxf"])
+                    [float(np.ptp(p.vertices, axis=0).max()) for p in model.panels], records["pieces"])
 
 
 @dataclass(frozen=True, eq=False)
 class PartResult:
-    """What :func:`flatten_part` did.
+    """What :func:`flatten_part` or :func:`unfold_part` did.
 
     Attributes
     ----------
-    model : patterns.Model
-    pattern : patterns.Pattern
-        As written (nested when a roll width was given).
-    report : patterns.audit.Report
+    subject : patterns.Pattern or patterns.Blank
+        What was flattened or unfolded.
+    model : patterns.Model or None
+        The part as loaded (None for an unfold, which reads the solid itself).
+    report : patterns.Report
+        The check, in the drawing's frame.
+    drawing : patterns.pieces.Drawing
+        The pieces as written (nested when a roll or sheet was given).
     written : dict
         ``{kind: staged path}`` of every output written.
     seconds : dict
         ``{"load": s, "flatten": s, "write": s}``.
-    nest : patterns.nesting.Layout or None
+    nest : patterns.Layout or None
     preview_dpi : float or None
         The resolution of a PNG preview (lowered for a large drawing).
+    comparison : patterns.BlankComparison or None
+        An unfold compared with another CAD program's flat pattern.
     """
 
-    model: object
-    pattern: object
-    report: object
+    subject: Pattern | Blank
+    model: Model | None
+    report: Report
+    drawing: Drawing
     written: dict = field(default_factory=dict)
     seconds: dict = field(default_factory=dict)
-    nest: object = None
+    nest: Layout | None = None
     preview_dpi: float | None = None
+    comparison: BlankComparison | None = None
+
+
+
+def _laid_out(subject, records: dict) -> tuple:
+    """``(drawing, nest or None)``: the subject's pieces, nested when the records give a roll or sheet."""
+    nesting = records.get("nest")
+    if nesting is not None and nesting.active:
+        nest = layout(subject, nesting, pieces=records["pieces"])
+        return nest.drawing(), nest
+    return drawing_of(subject, records["pieces"]), None
+
+
+def _write(subject, drawing: Drawing, checked: Drawing, records: dict, outputs: dict, stage: Callable) -> tuple:
+    """Every output, each to where ``stage`` says: ``({kind: staged path}, preview dpi)``."""
+    written, dpi = {}, None
+    options = records["write"]
+    for kind, path in outputs.items():
+        tmp = stage(path, what=OUTPUT_KINDS[kind][1])
+        if kind == "pattern" and path.suffix.lower() == ".obj":
+            unit = Unit(options.units)  # one unit for the whole run: the DXF's and the OBJ's
+            flat = subject.panels[0]
+            write_flat_obj(tmp, flat.uv / unit.mm, flat.faces)
+        elif kind == "pattern":
+            dialect = options.profile if path.suffix.lower() == ".dxf" or options.profile not in _DXF else None
+            write(drawing, tmp, replace(options, profile=dialect))
+        elif kind == "report":
+            write(checked, tmp, replace(options, profile="json"))
+        elif kind == "heat_map":
+            heat_map(subject, tmp)
+        else:
+            dpi = preview_dxf(written["pattern"], tmp)
+        written[kind] = tmp
+    return written, dpi
 
 
 def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, progress=None,
                  loaded: Callable | None = None) -> PartResult:
-    """Load, check the options against the part, flatten, nest, check, and write every output.
+    """Load, check the options against the part, flatten, make and nest the pieces, check, write every output.
 
     Parameters
     ----------
     source : str or Path
         The part's file.
     records : dict
-        The option records: ``"load"`` (LoadOptions), ``"flatten"``,
-        ``"check"``, ``"dxf"`` when a pattern is written, and ``"nest"``
-        (NestOptions: the pieces nested on a roll or sheets when it gives one).
+        The option records: ``"load"`` (LoadOptions), ``"flatten"``, ``"check"``, ``"pieces"``
+        (PieceOptions), ``"write"`` (WriteOptions) and ``"nest"`` (NestOptions: the pieces nested on a
+        roll or sheets when it gives one).
     outputs : dict
         ``{kind: Path}`` as :func:`plan_outputs` returns it.
     stage : callable
@@ -151,10 +227,6 @@ def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, progr
     -------
     PartResult
     """
-    from .audit import check
-    from .flattening import flatten
-    from .reading import load
-
     seconds = {}
     start = time.perf_counter()
     model = load(source, records["load"])
@@ -164,33 +236,39 @@ def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, progr
         loaded(model, seconds["load"])
     start = time.perf_counter()
     pattern = flatten(model, records["flatten"], progress=progress)
-    nest = None
-    if records.get("nest") is not None and records["nest"].active:
-        nest = pattern.layout(records["nest"])
-        pattern = nest.pattern
-    report = check(pattern, records["check"])
+    drawing, nest = _laid_out(pattern, records)
+    report, checked = checked_drawing(pattern, drawing, records["check"])
     seconds["flatten"] = time.perf_counter() - start
     start = time.perf_counter()
-    written, dpi = {}, None
-    for kind, path in outputs.items():
-        tmp = stage(path, what=OUTPUT_KINDS[kind][1])
-        if kind == "pattern" and path.suffix.lower() == ".dxf":
-            pattern.to_dxf(tmp, records["dxf"])
-        elif kind == "pattern":
-            from .export import write_flat_obj
-
-            unit = Unit(records["dxf"].units)  # one unit for the whole run: the DXF's and the OBJ's
-            flat = pattern.panels[0]
-            write_flat_obj(tmp, flat.uv / unit.mm, flat.faces)
-        elif kind == "report":
-            report.to_json(tmp)
-        elif kind == "heat_map":
-            pattern.heat_map(tmp)
-        else:
-            from .export.preview import preview_dxf
-
-            dpi = preview_dxf(written["pattern"], tmp)
-        written[kind] = tmp
+    written, dpi = _write(pattern, drawing, checked, records, outputs, stage)
     seconds["write"] = time.perf_counter() - start
-    return PartResult(model, pattern, report, written, seconds, nest, dpi)
+    return PartResult(pattern, model, report, drawing, written, seconds, nest, dpi)
 
+
+def unfold_part(source, records: dict, *, outputs: dict, stage: Callable,
+                reference: FlatPattern | None = None) -> PartResult:
+    """Unfold a bent sheet-metal part, make and nest its blank's pieces, check, write every output.
+
+    ``records`` as for :func:`flatten_part`, with ``"unfold"`` (UnfoldOptions) instead of ``"load"`` and
+    ``"flatten"``.  A blank that cannot be cut as it is (flanges that collide) writes nothing: its
+    result's report says why.  ``reference``: another CAD program's flat pattern of the part
+    (:func:`patterns.read_flat_pattern`), compared in the result and the report.
+    """
+    seconds = {}
+    start = time.perf_counter()
+    blank = unfold(source, records["unfold"])
+    seconds["load"] = 0.0
+    comparison = compare_blank(blank, reference) if reference is not None else None
+    if not blank.ok:
+        seconds["flatten"] = time.perf_counter() - start
+        return PartResult(blank, None, check(blank, records["check"]), drawing_of(blank, records["pieces"]),
+                          seconds=seconds, comparison=comparison)
+    drawing, nest = _laid_out(blank, records)
+    report, checked = checked_drawing(blank, drawing, records["check"])
+    if comparison is not None:
+        checked = replace(checked, report={**checked.report, "comparison": comparison.to_dict(reference.path)})
+    seconds["flatten"] = time.perf_counter() - start
+    start = time.perf_counter()
+    written, dpi = _write(blank, drawing, checked, records, outputs, stage)
+    seconds["write"] = time.perf_counter() - start
+    return PartResult(blank, None, report, drawing, written, seconds, nest, dpi, comparison)

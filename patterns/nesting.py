@@ -1,6 +1,8 @@
-"""Nesting: a pattern's pieces placed on a roll or on sheets, by sparrow (``spyrrow``).
+"""Nesting: pieces placed on a roll or on sheets, by sparrow (``spyrrow``).
 
-:func:`layout` hands the true outlines (with the seam allowance) to sparrow, the
+:func:`layout` takes pieces (:mod:`patterns.pieces`: a pattern's panels, a
+blank, or any mix of them) and hands their true cut outlines (the seam
+allowance included) to sparrow, the
 state-of-the-art heuristic for irregular strip packing (J. Gardeyn and T.
 Wauters; ``spyrrow`` is its Python binding), with the gap as the least distance
 between two pieces and the grain as the orientations allowed; then checks the
@@ -37,10 +39,12 @@ import numpy as np
 import shapely
 from shapely import affinity
 
+from .curves import Motion
 from .errors import InputError, LayoutError, PatternsError
 from .files import atomic_output
 from .options import Options, check_number, option
-from .predicates import flat_polygon
+from .pieces import Drawing, Piece, PieceOptions, pieces_of
+from .pieces.drawing import place_nest
 
 __all__ = ["ROTATIONS", "SHEET_SPACING", "Layout", "LayoutError", "NestOptions", "Sheet", "cache_folder", "layout"]
 
@@ -107,15 +111,15 @@ class NestOptions(Options):
                                        "(command line: 2500x1250)", check=_sheet, parse=_parse_sheet,
                                  optional=True, metavar="LxW")
     gap: float = option(10.0, "least distance between two pieces, mm", low=0, unit="mm", flag="--nest-gap")
-    margin: float = option(0.0, "room kept around each outline, mm (the seam allowance; the command line "
-                                "takes the largest --seam-allowance)", low=0, high=1000, unit="mm")
+    margin: float = option(0.0, "room kept around each piece's cut outline besides the gap, mm (a kerf, a "
+                                "cutter's clearance)", low=0, high=1000, unit="mm")
     rotations: str = option("grain", "how pieces may turn: grain (0 or 180 degrees: the grain along the roll), "
                                      "quarter (multiples of 90), free, none", choices=ROTATIONS)
-    copies: int = option(1, "pieces of every panel (a pattern cut this many times)", integer=True, low=1,
+    copies: int = option(1, "pieces of every panel or blank (a part cut this many times)", integer=True, low=1,
                          high=10000, metavar="N")
     mirror: bool = option(False, "each piece also as its mirror image (left and right)")
-    quantities: dict | None = option(None, "pieces of named panels, over copies (API: {'sleeve': 2}; command "
-                                           "line NAME=N, repeatable)", check=_quantities, parse=_parse_quantity,
+    quantities: dict | None = option(None, "pieces of named panels or blanks, over copies (API: {'sleeve': 2}; "
+                                           "command line NAME=N, repeatable)", check=_quantities, parse=_parse_quantity,
                                      repeat=True, flag="--quantity", metavar="NAME=N")
     time_limit: int = option(10, "seconds the nester searches (sparrow); longer may save a little material",
                              integer=True, low=1, high=86400, flag="--nest-time", metavar="S")
@@ -155,14 +159,17 @@ class Sheet:
 
 @dataclass(frozen=True, eq=False)
 class Layout:
-    """Where everything went and what it cost.
+    """Where everything went and what it cost (mm; the roll's corner at the origin, x across it).
 
     Attributes
     ----------
-    pattern : patterns.Pattern
-        The pattern laid out, copies included (``pattern.laid_out`` is True;
-        each panel's ``placement`` says where it is; ``pattern.stock`` the roll
-        or sheets, drawn in the DXF).
+    name : str
+        What was nested.
+    pieces : tuple of patterns.pieces.Piece
+        Every piece as placed, copies included (each piece's ``placement`` says how it was moved;
+        copies are named ``face0 #2``, ``face0 mirrored``).
+    stock : tuple of (x0, y0, x1, y1)
+        The roll (to the length used) or each sheet, mm.
     width : float
         The roll's (or sheets') width, mm.
     length : float
@@ -170,15 +177,19 @@ class Layout:
     area_used : float
         ``width * length``, mm^2 (a nest on sheets: the sheets' area).
     area_panels : float
-        The area the pieces take: their outlines with the margin, holes counted in (nothing else is cut
-        there), mm^2.
+        The area the pieces take: their cut outlines with the margin, holes counted in (nothing else is
+        cut there), mm^2.
     sheets : tuple of Sheet
         Sheet by sheet, for a nest on sheets; empty on a roll.
     seconds : float
         The search's time.
+    sources : tuple
+        The patterns and blanks nested (their check report follows the pieces into the drawing).
     """
 
-    pattern: object  # a patterns.Pattern (pattern.py imports this module for Pattern.layout)
+    name: str
+    pieces: tuple
+    stock: tuple
     width: float
     length: float
     area_used: float
@@ -186,11 +197,18 @@ class Layout:
     sheets: tuple = ()
     seconds: float = 0.0
     options: NestOptions = field(default_factory=NestOptions)
+    sources: tuple = ()
 
     @property
     def efficiency(self) -> float:
         """Share of the used material that ends up in pieces (0..1)."""
         return self.area_panels / self.area_used if self.area_used > 0 else 0.0
+
+    def drawing(self) -> Drawing:
+        """The nest as a drawing: pieces and stock moved together into the first quadrant (the frame every
+        file of it uses), with its summary as the note."""
+        pieces, stock = place_nest(self.pieces, self.stock)
+        return Drawing(self.name, pieces, stock, str(self))
 
     def __str__(self) -> str:
         if self.sheets:
@@ -200,20 +218,36 @@ class Layout:
         return f"a {self.width:g} mm roll: {self.length:.1f} mm used, efficiency {self.efficiency:.1%}"
 
 
-def layout(pattern, options: NestOptions | None = None, **keywords) -> Layout:
-    """Nest a pattern's pieces on a roll or on sheets (sparrow), checked with shapely.
+def _with_copies(pieces: tuple, counts: list, mirror: bool) -> tuple:
+    """The pieces, then each one's extra copies (``face0 #2``) and, with ``mirror``, its mirror images."""
+    extra = []
+    for piece, n in zip(pieces, counts):
+        extra += [piece.copy(f"{piece.name} #{k + 1}", k) for k in range(1, n)]
+        if mirror:
+            extra += [piece.copy(f"{piece.name} mirrored" if k == 0 else f"{piece.name} #{k + 1} mirrored", n + k,
+                                 mirrored=True) for k in range(n)]
+    return tuple(pieces) + tuple(extra)
+
+
+def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions | None = None,
+           **keywords) -> Layout:
+    """Nest pieces on a roll or on sheets (sparrow), checked with shapely.
 
     Parameters
     ----------
-    pattern : patterns.Pattern
+    source : patterns.Pattern, patterns.Blank, patterns.pieces.Piece, or a list of them
+        What to nest: a pattern's panels, a blank, or any mix (a marker of several parts).
     options : NestOptions, optional
         The options as a record; keywords go over it: ``width`` (a roll, mm)
         or ``sheet`` (``(length, width)`` mm), ``gap`` (least distance between
-        pieces, default 10 mm), ``margin`` (room around each outline: the seam
-        allowance), ``rotations`` (``"grain"``: 0 or 180 degrees, the default;
+        pieces, default 10 mm), ``margin`` (room around each cut outline),
+        ``rotations`` (``"grain"``: 0 or 180 degrees, the default;
         ``"quarter"``, ``"free"``, ``"none"``), ``copies``, ``mirror``,
-        ``quantities`` (``{panel name: count}``), ``time_limit`` (seconds,
+        ``quantities`` (``{piece name: count}``), ``time_limit`` (seconds,
         default 10), ``seed``.
+    pieces : patterns.pieces.PieceOptions, optional
+        What goes onto each piece (the seam allowance is part of its outline); keywords (``seam_allowance``,
+        ...) go over it.
 
     Returns
     -------
@@ -227,33 +261,35 @@ def layout(pattern, options: NestOptions | None = None, **keywords) -> Layout:
         A piece that fits the roll or sheet in no allowed orientation, or a
         result that fails the shapely check (never returned).
     """
-    if not (hasattr(pattern, "panels") and callable(getattr(pattern, "with_copies", None))):
-        raise InputError(f"layout() takes a patterns.Pattern, got {type(pattern).__name__}")
-    opts = NestOptions.of(options, keywords, name=pattern.name)
+    nest_fields = set(NestOptions.__dataclass_fields__)
+    items = list(source) if isinstance(source, (list, tuple)) else [source]
+    name = " + ".join(dict.fromkeys(str(getattr(item, "name", type(item).__name__)) for item in items))
+    opts = NestOptions.of(options, {k: v for k, v in keywords.items() if k in nest_fields}, name=name)
     if not opts.active:
-        raise InputError(f"{pattern.name}: give a roll width or a sheet to nest on")
-    names = [flat.name for flat in pattern.panels]
+        raise InputError(f"{name}: give a roll width or a sheet to nest on")
+    base = pieces_of(source, pieces, **{k: v for k, v in keywords.items() if k not in nest_fields})
+    names = [p.name for p in base]
     counts = [opts.copies] * len(names)
-    for name, n in (opts.quantities or {}).items():
-        if name not in names:
-            raise InputError(f"{pattern.name}: quantities name panel {name!r}; the panels are {', '.join(names)}")
-        counts[names.index(name)] = n
-    pieces = pattern.with_copies(counts, mirror=opts.mirror)
-    shapes = [_outline(flat, opts.margin) for flat in pieces.panels]
+    for piece_name, n in (opts.quantities or {}).items():
+        if piece_name not in names:
+            raise InputError(f"{name}: quantities name piece {piece_name!r}; the pieces are {', '.join(names)}")
+        counts[names.index(piece_name)] = n
+    every = _with_copies(base, counts, opts.mirror)
+    shapes = [_outline(piece, opts.margin) for piece in every]
     across = opts.width if opts.width is not None else opts.sheet[1]
     along = None if opts.sheet is None else opts.sheet[0]
-    for flat, shape in zip(pieces.panels, shapes):
-        _check_fits(pattern.name, flat.name, shape, across, along, opts.rotations)
+    for piece, shape in zip(every, shapes):
+        _check_fits(name, piece.name, shape, across, along, opts.rotations)
     start = time.perf_counter()
     if opts.sheet is None:
-        placements = _solve(shapes, list(range(len(shapes))), across, opts, pattern.name)
+        placements = _solve(shapes, list(range(len(shapes))), across, opts, name)
         sheets, stock = (), [(0.0, 0.0, across, None)]
     else:
-        placements, sheets, stock = _fill_sheets(shapes, pieces, opts, pattern.name)
+        placements, sheets, stock = _fill_sheets(shapes, every, opts, name)
     seconds = time.perf_counter() - start
-    laid = pieces.placed([placements[i] for i in range(len(shapes))])
-    placed = [_outline(flat, opts.margin) for flat in laid.panels]
-    _verify(pattern.name, laid, placed, across, opts, stock)
+    laid = tuple(piece.moved(Motion(*placements[i])) for i, piece in enumerate(every))
+    placed = [_outline(piece, opts.margin) for piece in laid]
+    _verify(name, laid, placed, across, opts, stock)
     area_pieces = float(sum(p.area for p in placed))
     if sheets:
         length = opts.sheet[0] * len(sheets)
@@ -263,14 +299,14 @@ def layout(pattern, options: NestOptions | None = None, **keywords) -> Layout:
         length = max(float(np.max(np.asarray(p.exterior.coords)[:, 1])) for p in placed)
         used = across * length
         rects = ((0.0, 0.0, across, length),)
-    result = Layout(None, float(across), float(length), float(used), area_pieces, tuple(sheets), seconds, opts)
-    laid = replace(laid, stock=rects, stock_note=str(result))
-    return replace(result, pattern=laid)
+    sources = tuple(item for item in items if not isinstance(item, Piece))
+    return Layout(name, laid, rects, float(across), float(length), float(used), area_pieces, tuple(sheets), seconds,
+                  opts, sources)
 
 
-def _outline(flat, margin: float):
+def _outline(piece: Piece, margin: float):
     """The piece's cut outline as placed (holes not offered as room), grown by the margin."""
-    outline = flat_polygon(flat.uv, flat.loops, holes=False)
+    outline = piece.outline.polygon
     return outline.buffer(margin, join_style="mitre") if margin else outline
 
 
@@ -428,7 +464,7 @@ def _fill_sheets(shapes, pieces, opts, name):
             angle, dx, dy = found[i]
             placements[i] = (angle, dx, dy + offset)
         area = float(sum(shapes[i].area for i in on_sheet))
-        sheets.append(Sheet(len(sheets), tuple(pieces.panels[i].name for i in on_sheet), area, length * width))
+        sheets.append(Sheet(len(sheets), tuple(pieces[i].name for i in on_sheet), area, length * width))
         stock.append((0.0, offset, width, offset + length))
         left = [i for i in left if i not in on_sheet]
     return placements, sheets, stock
@@ -442,10 +478,10 @@ def _verify(name, laid, placed, across, opts, stock) -> None:
     for a, b in zip(left, right):
         if a < b and (opts.gap > 0 or placed[a].intersection(placed[b]).area > tol):
             d = placed[a].distance(placed[b])
-            raise LayoutError(f"{name}: pieces {laid.panels[a].name} and {laid.panels[b].name} lie {d:.3f} mm "
+            raise LayoutError(f"{name}: pieces {laid[a].name} and {laid[b].name} lie {d:.3f} mm "
                               f"apart, under the {opts.gap:g} mm gap (the nest is refused, not written)")
     rects = [shapely.box(x0, y0, x1, y1 if y1 is not None else 1e12) for x0, y0, x1, y1 in stock]
     room = shapely.union_all(rects).buffer(tol)
-    for flat, shape in zip(laid.panels, placed):
+    for piece, shape in zip(laid, placed):
         if not room.contains(shape):
-            raise LayoutError(f"{name}: piece {flat.name} lies off the roll or sheet (the nest is refused)")
+            raise LayoutError(f"{name}: piece {piece.name} lies off the roll or sheet (the nest is refused)")

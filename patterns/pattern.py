@@ -346,11 +346,16 @@ class FlatSeam:
     ----------
     seam : patterns.Seam
     flat_lengths : (float, float)
-        Length of the seam's polyline in the flat pattern on side 0 and side 1,
-        mm.  The difference is what puckers when the pieces are sewn or welded.
-    held_lengths : (float, float) or None
+        Flat length of the seam on side 0 and side 1, mm: the length of its
+        polyline in the flat pattern, or, on an exactly developed side, of its
+        exact curve laid flat (an isometry: the seam's exact CAD length, on the
+        neutral surface with a thickness).  The difference is what puckers when
+        the pieces are sewn or welded.
+    held_lengths : (float or None, float or None) or None
         The flat length each side was held at (``flatten(seams="true")``): the
-        3D length of its polyline times its ease, mm; None for a free seam.
+        3D length of its polyline times its ease, mm; None for a side that is
+        not held (an exact development keeps every length without being
+        held), None for a free seam.
     """
 
     seam: Seam
@@ -398,11 +403,6 @@ class Pattern:
     """True once the panels have been placed on a sheet (:meth:`placed`): only
     then are panels checked against each other."""
     max_strain: float | None = None
-    stock: tuple = ()
-    """Once nested (:func:`patterns.layout`): the roll or each sheet as ``(x0, y0, x1, y1)`` mm, drawn
-    in the DXF on layer STOCK."""
-    stock_note: str = ""
-    """Once nested: what the nest used ("a 1500 mm roll: 3592.0 mm used, efficiency 74.2 %")."""
 
     @property
     def name(self) -> str:
@@ -412,51 +412,6 @@ class Pattern:
     def one_to_one(self) -> bool:
         """True when no panel overlaps itself."""
         return all(p.flattening.one_to_one for p in self.panels)
-
-    def to_dxf(self, path, options=None, **keywords) -> None:
-        """Write the pattern as a DXF file for a cutter (atomically).
-
-        Parameters
-        ----------
-        path : str or Path
-        options : patterns.DxfOptions, optional
-            The options as a record; keyword arguments (any field of
-            :class:`~patterns.DxfOptions`: ``profile``, ``seam_allowance``,
-            ``units``, ``version``, ``strain_layer``, ``text_height``, ``gap``,
-            ``arcs``, ``arc_tolerance``, ``bend_spacing``, ``notch_spacing``,
-            ``notch_style``, ``seam_corners``) go over it.  ``profile="machine"``
-            (default; laser, plasma, waterjet, knife plotter) writes layers CUT,
-            SEW, NOTCH, GRAIN, BEND, LABEL (and STRAIN), every cut contour one
-            closed polyline; ``"astm"`` (garment CAD) writes ASTM D6673 R12, one
-            block per piece.  See docs/dxf.md.
-
-        Raises
-        ------
-        InputError
-            An unknown option or a bad value (nothing is written).
-        ExportError
-            The file cannot be written.
-        """
-        from .export.dxf import write_pattern_dxf  # ezdxf is imported only when a DXF is written
-
-        write_pattern_dxf(self, path, options, **keywords)
-
-    def layout(self, options=None, **keywords):
-        """Nest the pieces on a roll (``width=``) or on sheets (``sheet=(length, width)``); the options
-        and their defaults are those of :func:`patterns.layout` (:class:`patterns.NestOptions`).
-
-        Returns a :class:`patterns.nesting.Layout`: ``.pattern`` (laid out,
-        copies included), ``.length`` used, ``.efficiency``, ``.sheets``.
-        """
-        from .nesting import layout
-
-        return layout(self, options, **keywords)
-
-    def heat_map(self, path, **options) -> None:
-        """Write the strain heat map (PNG or SVG); see :func:`patterns.heat_map`."""
-        from .export.heatmap import heat_map
-
-        heat_map(self, path, **options)
 
     @classmethod
     def combined(cls, patterns) -> Pattern:

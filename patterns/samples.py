@@ -22,6 +22,9 @@ names in ``samples/`` to them (``samples/make_cad.py`` writes those files, and
 * ``rolled_cylinder`` -- a rolled shell, 500 mm across and 500 mm high: one
   cylindrical face closed by its seam line (sheet metal: its blank is a
   rectangle, 2 pi times the neutral radius long).
+* ``bracket`` -- a bent sheet-metal L bracket: 2 mm sheet, 60 and 40 mm legs
+  (to the centre line), 40 mm wide, inside bend radius 3 mm, an 8 mm hole in
+  the long leg (``patterns unfold samples/bracket.step``).
 
 Two more parts, built here but not bundled as files (the seam tests and
 ``benchmarks/seams.py`` use them):
@@ -154,6 +157,20 @@ def sphere_gores():
     return bd.Shell([q.faces().filter_by(bd.GeomType.SPHERE)[0] for q in quarters])
 
 
+def bracket(thickness: float = 2.0, radius: float = 3.0, width: float = 40.0):
+    """An L bracket bent from a ``thickness`` mm sheet (inside radius ``radius``, ``width`` wide): a
+    rectangle swept along the filleted centre line (60 mm along x, then 40 mm along y), an 8 mm hole
+    through the long leg's middle; a solid."""
+    import build123d as bd
+
+    with bd.BuildLine() as line:
+        bd.FilletPolyline((60, 0), (0, 0), (0, 40), radius=radius + thickness / 2)
+    path = line.wire()
+    plane = bd.Plane(origin=path.position_at(0), x_dir=(0, 0, 1), z_dir=path.tangent_at(0))
+    part = bd.sweep(plane * bd.Rectangle(width, thickness), path=path, transition=bd.Transition.RIGHT)
+    return part - bd.Plane(origin=(30, 0, 0), z_dir=(0, 1, 0)) * bd.Cylinder(4, 50)
+
+
 SAMPLES = {
     "duct_transition.step": duct_transition,
     "hopper.step": hopper,
@@ -161,4 +178,5 @@ SAMPLES = {
     "hull_panel.step": hull_panel,
     "rolled_cylinder.step": rolled_cylinder,
     "square_to_round.step": square_to_round,
+    "bracket.step": bracket,
 }

@@ -62,3 +62,9 @@ def small_disk(path: Path, size: str, *options) -> None:
                           capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         pytest.skip(f"cannot mount a small file system here ({proc.stderr.strip()})")
+
+
+def is_dashed(doc, linetype: str) -> bool:
+    """True when a DXF linetype draws dashes with gaps between them (a group-49 element below zero)."""
+    entry = doc.linetypes.get(linetype)
+    return entry is not None and any(t.code == 49 and t.value < 0 for t in entry.pattern_tags.tags)

@@ -1,10 +1,10 @@
-"""patterns.export.arcs: arcs and lines fitted to outlines, against the exact curves."""
+"""patterns.pieces.arcs: arcs and lines fitted to outlines, against the exact curves."""
 
 import numpy as np
 import pytest
 import shapely
 
-from patterns.export.arcs import arc_points, fit_arcs
+from patterns.pieces.arcs import arc_points, fit_arcs
 
 
 def test_a_sampled_circle_becomes_a_few_arcs_on_the_circle():

@@ -117,7 +117,7 @@ def test_demo_runs_the_whole_pipeline(tmp_path):
         assert str(out / name) in proc.stdout or f"patterns-demo/{name}" in proc.stdout
     doc, auditor = recover.readfile(out / "cup.dxf")
     assert not auditor.has_errors and len(doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')) == 4
-    assert json.loads((out / "cup.json").read_text())["schema"] == "patterns.report/4"
+    assert json.loads((out / "cup.json").read_text())["schema"] == "patterns.report/5"
 
 
 def _batch_folder(folder: Path, n_good: int = 20) -> list[str]:
@@ -192,7 +192,7 @@ def test_batch_exit_codes(tmp_path):
     [
         (("flatten", "missing.obj", "-o", "x.dxf"), "missing.obj: no such file"),
         (("flatten", "missing.step", "-o", "x.dxf"), "missing.step: no such file"),
-        (("flatten", SAMPLES / "dish.obj", "-o", "x.pdf"), "x.pdf: -o writes .dxf or .obj, not '.pdf'"),
+        (("flatten", SAMPLES / "dish.obj", "-o", "x.pdf"), "x.pdf: -o writes .dxf, .svg or .obj, not '.pdf'"),
         (("flatten", SAMPLES / "dish.obj", "-o", "nofolder/x.dxf"), "folder nofolder does not exist"),
         (("flatten", SAMPLES / "cup.step", "-o", "x.obj"), "4 panels; a flat .obj holds one"),
         (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--max-edge", "-1"), "max_edge"),
@@ -285,7 +285,7 @@ def test_garment_options(tmp_path):
     assert not auditor.has_errors
     assert len(doc.modelspace().query('LINE[layer=="NOTCH"]')) == 4 * 2 * 8
     cuts = [shapely.Polygon([p[:2] for p in e.get_points("xy")]) for e in doc.modelspace().query('LWPOLYLINE[layer=="CUT"]')]
-    margin = patterns.export.dxf.MARGIN  # the drawing starts this far from the axes
+    margin = patterns.pieces.MARGIN  # the drawing starts this far from the axes
     assert max(c.bounds[2] for c in cuts) <= 600 + margin + 1e-6 and min(c.bounds[0] for c in cuts) >= margin - 1e-6
     bad = run("flatten", SAMPLES / "cup.step", "-o", tmp_path / "x.dxf", "--grain", "1,2")
     assert bad.returncode == 2 and "X,Y,Z" in bad.stderr

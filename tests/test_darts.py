@@ -108,25 +108,28 @@ def test_the_report_and_the_dxf_list_every_dart(hemisphere, tmp_path):
         assert row.length_3d == pytest.approx(np.linalg.norm(np.diff(flat.vertices[dart.path], axis=0), axis=1).sum())
         assert row.legs_flat == pytest.approx(leg_lengths(flat, dart))
         assert row.tip == pytest.approx(tuple(flat.uv[dart.tip]))
-    report.to_json(tmp_path / "report.json")
-    doc = json.loads((tmp_path / "report.json").read_text())
-    assert doc["schema"] == "patterns.report/4"
-    assert [d["legs_flat"] for d in doc["panels"][0]["darts"]] == [list(d.legs_flat) for d in darts]
-    assert [d["tip"] for d in doc["panels"][0]["darts"]] == [list(d.tip) for d in darts]
     (note,) = [f for f in report.findings if f.code is patterns.Code.DARTS]
     assert len(note.points) == len(flat.darts)
     # The DXF, read back: a drill hole (POINT on DRILL) at every tip, a notch where every leg meets
     # the outline, the cut line running into each dart.
     path = tmp_path / "hemisphere.dxf"
-    pattern.to_dxf(path)
+    patterns.write(pattern, path)
     msp = ezdxf.readfile(path).modelspace()
     shift = drawing_shift(msp, pattern, "CUT")
+    # the JSON report: every dart, its tip where the DXF drills it
+    patterns.write(pattern, tmp_path / "report.json")
+    doc = json.loads((tmp_path / "report.json").read_text())
+    assert doc["schema"] == "patterns.report/5"
+    np.testing.assert_allclose([d["legs_flat"] for d in doc["panels"][0]["darts"]], [d.legs_flat for d in darts],
+                               rtol=1e-12)  # lengths: the same, wherever the piece lies
+    np.testing.assert_allclose([d["tip"] for d in doc["panels"][0]["darts"]], np.array([d.tip for d in darts]) + shift,
+                               atol=1e-9)
     drills = np.array([tuple(p.dxf.location)[:2] for p in msp.query('POINT[layer=="DRILL"]')])
     tips = np.array([flat.uv[d.tip] for d in flat.darts]) + shift
     assert len(drills) == len(tips)
     assert np.abs(np.sort(drills, axis=0) - np.sort(tips, axis=0)).max() < 1e-6
     for allowance in (0.0, 10.0):
-        pattern.to_dxf(path, seam_allowance=allowance)
+        patterns.write(pattern, path, seam_allowance=allowance)
         msp = ezdxf.readfile(path).modelspace()
         ends = [(np.array(tuple(line.dxf.start)[:2]), np.array(tuple(line.dxf.end)[:2]))
                 for line in msp.query('LINE[layer=="NOTCH"]')]
@@ -153,7 +156,7 @@ def test_the_report_and_the_dxf_list_every_dart(hemisphere, tmp_path):
             assert np.min(np.linalg.norm(np.array(sew.exterior.coords) - tip, axis=1)) < 1e-6
     # ASTM: the drill holes on layer 13.
     astm = tmp_path / "hemisphere_astm.dxf"
-    pattern.to_dxf(astm, profile="astm")
+    patterns.write(pattern, astm, profile="astm")
     doc = ezdxf.readfile(astm)
     points = [e for b in doc.blocks for e in b if e.dxftype() == "POINT" and e.dxf.layer == "13"]
     assert len(points) == len(flat.darts)
@@ -214,7 +217,7 @@ def test_gores_split_a_dome_into_pieces_that_each_meet_the_limit(hemisphere, sou
     if source == "hemisphere":  # 13 gores: held at 3D length, a gore may be 2 sqrt(2 x 3 %) rad wide
         assert len(gores.panels) == int(np.ceil(2 * np.pi / (2 * np.sqrt(2 * LIMIT))))
     # The DXF: one cut contour per piece.
-    pattern.to_dxf(tmp_path / "gores.dxf")
+    patterns.write(pattern, tmp_path / "gores.dxf")
     msp = ezdxf.readfile(tmp_path / "gores.dxf").modelspace()
     assert len(msp.query('LWPOLYLINE[layer=="CUT"]')) == len(gores.panels)
 
@@ -230,7 +233,7 @@ def test_real_readers_read_the_darted_pattern(cup_darts, tmp_path):
     from .test_dxf_pattern import READERS, _need, _qt_env, ring_numbers
 
     path = tmp_path / "cup_darts.dxf"
-    cup_darts.to_dxf(path, version="R2000")
+    patterns.write(cup_darts, path, version="R2000")
     _need("dxf2gcode")
     proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
                           capture_output=True, text=True, env=_qt_env(tmp_path), timeout=120)

@@ -20,8 +20,11 @@ from ezdxf import recover
 
 import patterns
 from patterns.errors import ExportError, InputError
-from patterns.export.dxf import MACHINE_LAYERS
+from patterns.export.layers import PRESETS
 from patterns.export.preview import preview_dxf
+
+MACHINE_LAYERS = {layer.name for layer in PRESETS["patterns"].values()}
+"""The layers of the machine profile's default layer map."""
 
 from .conftest import SAMPLES
 from .helpers import drawing_shift, small_disk
@@ -67,7 +70,7 @@ def ring_numbers(pts):
 @pytest.mark.parametrize("version", ["R12", "R2000", "R2018"])
 def test_machine_cut_contours_are_the_flat_outlines(plate, tmp_path, version):
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, version=version)
+    patterns.write(plate, path, version=version)
     doc = read(path)
     assert doc.dxfversion == ezdxf.const.acad_release_to_dxf_version[version]
     cuts = polylines(doc, "CUT")
@@ -100,7 +103,7 @@ def test_machine_cut_contours_are_the_flat_outlines(plate, tmp_path, version):
 
 def test_seam_annotations_equal_the_report(cup, tmp_path):
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path)
+    patterns.write(cup, path)
     report = patterns.check(cup)
     texts = [t.dxf.text for t in read(path).modelspace().query('TEXT[layer=="LABEL"]')]
     seams = [re.fullmatch(r"S(\d+) 3D ([\d.]+) FLAT ([\d.]+) MM", t) for t in texts]
@@ -117,12 +120,12 @@ def test_seam_annotations_equal_the_report(cup, tmp_path):
 
 def test_seam_allowance_offsets_the_cut_line_and_keeps_the_seam_line(cup, tmp_path):
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, seam_allowance=10.0)
+    patterns.write(cup, path, seam_allowance=10.0)
     doc = read(path)
     sews, cuts = polylines(doc, "SEW"), polylines(doc, "CUT")
     assert len(cuts) == len(sews) == 4
-    for (sew, _), (cut, closed) in zip(sorted(sews, key=lambda x: x[0][:, 0].min()),
-                                       sorted(cuts, key=lambda x: x[0][:, 0].min())):
+    for sew, _ in sews:  # each seam line with the cut line around it
+        (cut, closed), = [(c, k) for c, k in cuts if shapely.Polygon(c).contains(shapely.Polygon(sew).centroid)]
         assert closed
         seam_line, cut_line = shapely.Polygon(sew), shapely.Polygon(cut)
         assert cut_line.contains(seam_line)
@@ -132,7 +135,7 @@ def test_seam_allowance_offsets_the_cut_line_and_keeps_the_seam_line(cup, tmp_pa
         assert np.median(d) == pytest.approx(10.0, abs=1e-4) and d.min() > 10.0 - 1e-4
     # Per seam: 15 mm on seam 0, 5 mm elsewhere.
     path2 = tmp_path / "cup2.dxf"
-    cup.to_dxf(path2, seam_allowance={0: 15.0, None: 5.0})
+    patterns.write(cup, path2, seam_allowance={0: 15.0, None: 5.0})
     doc2 = read(path2)
     seam0 = cup.seams[0].seam
     panel = seam0.panels[0]
@@ -156,7 +159,7 @@ def _placed_offset(doc, pattern, panel):
 
 def test_notches_mark_both_ends_of_every_seam(cup, tmp_path):
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, seam_allowance=8.0)
+    patterns.write(cup, path, seam_allowance=8.0)
     notches = read(path).modelspace().query('LINE[layer=="NOTCH"]')
     assert len(notches) == 2 * 2 * len(cup.seams)
     for line in notches:
@@ -165,7 +168,7 @@ def test_notches_mark_both_ends_of_every_seam(cup, tmp_path):
 
 def test_astm_profile_is_piece_blocks_for_garment_cad(cup, tmp_path):
     path = tmp_path / "cup_astm.dxf"
-    cup.to_dxf(path, profile="astm", seam_allowance=10.0)
+    patterns.write(cup, path, profile="astm", seam_allowance=10.0)
     text = path.read_text(encoding="ascii")
     # What Gerber's parser wants: no handles, no layout blocks; a header with only the units.
     assert "$MODEL_SPACE" not in text.upper() and "$PAPER_SPACE" not in text.upper()
@@ -206,7 +209,7 @@ def test_astm_profile_is_piece_blocks_for_garment_cad(cup, tmp_path):
 
 def test_preview_is_the_file_at_one_to_one(cup, tmp_path):
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, seam_allowance=10.0)
+    patterns.write(cup, path, seam_allowance=10.0)
     extents = ezdxf.bbox.extents(read(path).modelspace())
     svg = tmp_path / "cup.svg"
     preview_dxf(path, svg, margin=10.0)
@@ -227,7 +230,7 @@ def test_preview_is_the_file_at_one_to_one(cup, tmp_path):
     assert np.count_nonzero((rgb[..., 2] > 0.8) & (rgb[..., 0] < 0.3)) > 100
     # The ASTM file renders too (its layers have no table: named for the preview).
     astm = tmp_path / "astm.dxf"
-    cup.to_dxf(astm, profile="astm")
+    patterns.write(cup, astm, profile="astm")
     preview_dxf(astm, tmp_path / "astm.png", dpi=30)
     dark = matplotlib.image.imread(tmp_path / "astm.png")[..., :3].mean(axis=2) < 0.5
     assert np.count_nonzero(dark) > 500
@@ -235,7 +238,7 @@ def test_preview_is_the_file_at_one_to_one(cup, tmp_path):
 
 def test_strain_layer(cup, tmp_path):
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, strain_layer=True, version="R2004")
+    patterns.write(cup, path, strain_layer=True, version="R2004")
     doc = read(path)
     solids = doc.modelspace().query('SOLID[layer=="STRAIN"]')
     assert len(solids) == sum(len(p.faces) for p in cup.panels)
@@ -266,7 +269,7 @@ def test_strain_layer(cup, tmp_path):
 def test_strain_colours_are_the_version_s(cup, tmp_path, version):
     """True colour from R2004 on; R12 and R2000 have none (ACI red or blue)."""
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, strain_layer=True, version=version)
+    patterns.write(cup, path, strain_layer=True, version=version)
     solids = read(path).modelspace().query('SOLID[layer=="STRAIN"]')
     assert len(solids) > 0 and not any(s.dxf.hasattr("true_color") for s in solids)
     assert {s.dxf.color for s in solids} == {1, 5}
@@ -275,7 +278,7 @@ def test_strain_colours_are_the_version_s(cup, tmp_path, version):
 def test_labels_read_left_to_right():
     """A label along a direction is turned to read left to right, never upside down: its angle lies in
     (-90, 90] degrees, the direction's or the opposite one's."""
-    from patterns.export.dxf import _readable_angle
+    from patterns.pieces.labels import readable_angle as _readable_angle
 
     cases = {(1, 0): 0.0, (0, 1): 90.0, (0, -1): 90.0, (-1, 0): 0.0, (1, 1): 45.0, (-1, -1): 45.0,
              (-1, 1): -45.0, (1, -1): -45.0, (-1, 1e-9): pytest.approx(-1e-9 * 180 / np.pi, abs=1e-12)}
@@ -286,7 +289,7 @@ def test_labels_read_left_to_right():
 def test_grain_lines_lie_inside_their_pieces(cup, plate, tmp_path):
     for name, pattern in (("cup", cup), ("plate", plate)):
         path = tmp_path / f"{name}.dxf"
-        pattern.to_dxf(path)
+        patterns.write(pattern, path)
         doc = read(path)
         cuts = _polygons(doc, "CUT")
         lines = doc.modelspace().query('LINE[layer=="GRAIN"]')
@@ -298,7 +301,7 @@ def test_grain_lines_lie_inside_their_pieces(cup, plate, tmp_path):
 
 def test_a_text_height_given_is_the_text_height(cup, tmp_path):
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, version="R12", text_height=7.0)
+    patterns.write(cup, path, version="R12", text_height=7.0)
     (units,) = [t for t in read(path).modelspace().query("TEXT") if t.dxf.text.startswith("UNITS:")]
     assert units.dxf.height == 7.0
 
@@ -307,7 +310,7 @@ def test_astm_texts_are_six_tenths_of_the_text_height(cup, tmp_path):
     """ASTM text_height=5: the style's lines in model space and every piece's text (its lines, its seam
     labels) are 3 mm high, 0.6 of it."""
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, profile="astm", text_height=5.0)
+    patterns.write(cup, path, profile="astm", text_height=5.0)
     doc = read(path)
     texts = list(doc.modelspace().query("TEXT"))
     texts += [e for ents in _block_entities(doc).values() for e in ents if e.dxftype() == "TEXT"]
@@ -319,7 +322,8 @@ def test_astm_texts_are_six_tenths_of_the_text_height(cup, tmp_path):
 def test_marks_are_counted_before_drawing():
     """check_marks' estimates: 2 x (seam length / notch spacing + seams) notches, the panels' sizes over
     the bend spacing for bend lines; refused over MAX_MARKS, not under."""
-    from patterns.export.dxf import MAX_MARKS, DxfOptions, check_marks
+    from patterns.pieces.options import MAX_MARKS, check_marks
+    from patterns.pieces.options import PieceOptions as DxfOptions
 
     seams, sizes = [1000.0] * 10, [500.0] * 8  # 10 m of seams, 4 m of panels
     notch_at = 2 * (10_000.0 / MAX_MARKS)  # about MAX_MARKS / 2 ... / 1 notches below and above
@@ -334,7 +338,7 @@ def test_marks_are_counted_before_drawing():
 
 
 def test_snap_drops_repeated_points_and_the_closing_one():
-    from patterns.export.dxf import _snap
+    from patterns.pieces.allowance import snap as _snap
 
     square = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], dtype=float)
     np.testing.assert_array_equal(_snap(np.vstack([square, square[:1]])), square)  # closed by repeating
@@ -346,7 +350,7 @@ def test_snap_drops_repeated_points_and_the_closing_one():
 def test_arcs_are_for_the_cut_line_only(cup, tmp_path):
     """arcs=True: the cut contours are fitted with arcs (bulges); the seam lines are drawn as they are."""
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, arcs=True, seam_allowance=10.0)
+    patterns.write(cup, path, arcs=True, seam_allowance=10.0)
     msp = read(path).modelspace()
     bulges = {layer: [b for e in msp.query(f'LWPOLYLINE[layer=="{layer}"]') for *_, b in e.get_points("xyb")]
               for layer in ("CUT", "SEW")}
@@ -356,10 +360,10 @@ def test_arcs_are_for_the_cut_line_only(cup, tmp_path):
 def test_layers_are_declared_only_when_used(cup, tmp_path):
     """STOCK (a nest's roll or sheets) and STRAIN (the strain solids) are declared only when drawn."""
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path)
+    patterns.write(cup, path)
     layers = {layer.dxf.name for layer in read(path).layers}
     assert {"CUT", "LABEL", "NOTCH", "GRAIN"} <= layers and not {"STOCK", "STRAIN"} & layers
-    cup.to_dxf(path, strain_layer=True)
+    patterns.write(cup, path, strain_layer=True)
     assert "STRAIN" in {layer.dxf.name for layer in read(path).layers}
 
 
@@ -368,7 +372,7 @@ def test_seam_labels_lie_inside_their_panel_near_their_seam(cup, tmp_path):
     seam: 1.6 x its own height, within the panel's own seam polyline's reach."""
     path = tmp_path / "cup.dxf"
     pattern = cup.placed([(0.0, 400.0 * k, 0.0) for k in range(len(cup.panels))])
-    pattern.to_dxf(path)
+    patterns.write(pattern, path)
     doc = read(path)
     shift = drawing_shift(doc.modelspace(), pattern, "CUT")
     labels = [t for t in doc.modelspace().query('TEXT[layer=="LABEL"]') if re.match(r"S\d+ 3D ", t.dxf.text)]
@@ -383,14 +387,14 @@ def test_seam_labels_lie_inside_their_panel_near_their_seam(cup, tmp_path):
 
 def test_a_per_seam_allowance_is_bounded_too(cup, tmp_path):
     with pytest.raises(InputError, match="seam_allowance"):
-        cup.to_dxf(tmp_path / "cup.dxf", seam_allowance={None: 5.0, cup.seams[0].seam.id: 1e6})
+        patterns.write(cup, tmp_path / "cup.dxf", seam_allowance={None: 5.0, cup.seams[0].seam.id: 1e6})
     assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize(
     ("kwargs", "words"),
     [
-        ({"profile": "gerber"}, "profile must be one of machine, astm, got .gerber."),
+        ({"profile": "gerber"}, "profile must be one of machine, astm, svg, json, got .gerber."),
         ({"units": "furlong"}, "units must be one of mm, cm, m, in"),
         ({"version": "R14"}, "version must be one of R12, R2000"),
         ({"profile": "astm", "version": "R2000"}, "R12 only"),
@@ -403,13 +407,13 @@ def test_a_per_seam_allowance_is_bounded_too(cup, tmp_path):
 def test_bad_options_write_nothing(cup, tmp_path, kwargs, words):
     path = tmp_path / "out.dxf"
     with pytest.raises(InputError, match=words):
-        cup.to_dxf(path, **kwargs)
+        patterns.write(cup, path, **kwargs)
     assert list(tmp_path.iterdir()) == []
 
 
 def test_failed_export_leaves_no_file(cup, tmp_path):
     with pytest.raises(ExportError, match="does not exist"):
-        cup.to_dxf(tmp_path / "missing" / "cup.dxf")
+        patterns.write(cup, tmp_path / "missing" / "cup.dxf")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -444,7 +448,7 @@ def _qt_env(tmp_path):
 def test_librecad_renders_the_file(plate, tmp_path, version):
     _need("librecad")
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, version=version)
+    patterns.write(plate, path, version=version)
     pdf = tmp_path / "plate.pdf"  # dxf2pdf writes FILE.pdf beside FILE.dxf
     # --fit: at the default 1:1 on A4 the 450 x 355 mm sheet falls off the page.
     proc = subprocess.run(["librecad", "dxf2pdf", "--fit", str(path)], capture_output=True, text=True,
@@ -468,7 +472,7 @@ def _inflate(stream: bytes) -> bytes:
 def test_dxf2gcode_finds_one_closed_contour_per_cut_loop(plate, tmp_path, version):
     """Holes too: the plate's cut loops (outlines and the hole's) each one closed contour."""
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, version=version, seam_allowance=5.0)
+    patterns.write(plate, path, version=version, seam_allowance=5.0)
     found = _dxf2gcode(path, tmp_path)
     n_loops = len(polylines(read(path), "CUT"))
     assert found["entities"]["CUT"]["contours"] == found["entities"]["CUT"]["closed"] == n_loops
@@ -478,7 +482,7 @@ def test_dxf2gcode_finds_one_closed_contour_per_cut_loop(plate, tmp_path, versio
 def test_freecad_reads_the_machine_profile(plate, tmp_path):
     _need("freecadcmd")
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path)
+    patterns.write(plate, path)
     proc = subprocess.run(["freecadcmd", str(READERS / "freecad_layers.py")], capture_output=True, text=True,
                           env=dict(_qt_env(tmp_path), DXF=str(path)), timeout=300)
     lines = [x for x in proc.stdout.splitlines() if "RESULT " in x]
@@ -523,7 +527,7 @@ def test_notch_slits_cut_into_the_allowance_never_into_the_piece(cup, tmp_path):
     middle lies inside the cut contour and outside every seam line (a slit flipped inwards would
     cut the finished piece)."""
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path, seam_allowance=10.0)
+    patterns.write(cup, path, seam_allowance=10.0)
     doc = read(path)
     cut, sew = shapely.union_all(_polygons(doc, "CUT")), shapely.union_all(_polygons(doc, "SEW"))
     lines = doc.modelspace().query('LINE[layer=="NOTCH"]')
@@ -540,7 +544,7 @@ def test_astm_notches_point_into_the_piece(cup, tmp_path):
     """An ASTM notch is a POINT on the cut line whose angle (group 50) points into the piece,
     as deep as the allowance: base + depth x direction lands on the seam line."""
     path = tmp_path / "cup_astm.dxf"
-    cup.to_dxf(path, profile="astm", seam_allowance=10.0)
+    patterns.write(cup, path, profile="astm", seam_allowance=10.0)
     doc = read(path)
     for insert in doc.modelspace().query("INSERT"):
         block = doc.blocks[insert.dxf.name]
@@ -628,7 +632,7 @@ def test_astm_pieces_read_back_entity_by_entity(tmp_path):
     sizes = sorted([(200.0, 100.0), (200.0, 50.0), (100.0, 50.0)] * 2)
     pattern = patterns.flatten(patterns.load(bd.Box(200, 100, 50), max_edge=25))
     path = tmp_path / "box_astm.dxf"
-    pattern.to_dxf(path, profile="astm", seam_allowance=10.0)
+    patterns.write(pattern, path, profile="astm", seam_allowance=10.0)
     doc = read(path)
     blocks = _block_entities(doc)
     assert len(blocks) == 6
@@ -680,8 +684,8 @@ def test_astm_internal_lines_are_the_rulings_of_a_rolled_panel(tmp_path):
     profile's BEND lines, the same segments, inside the piece."""
     pattern = patterns.flatten(patterns.load(SAMPLES / "rolled_cylinder.step"))
     astm, machine = tmp_path / "a.dxf", tmp_path / "m.dxf"
-    pattern.to_dxf(astm, profile="astm", bend_spacing=50.0)
-    pattern.to_dxf(machine, bend_spacing=50.0)
+    patterns.write(pattern, astm, profile="astm", bend_spacing=50.0)
+    patterns.write(pattern, machine, bend_spacing=50.0)
     lines = sorted(tuple(np.round(np.r_[tuple(e.dxf.start)[:2], tuple(e.dxf.end)[:2]], 6))
                    for ents in _block_entities(read(astm)).values() for e in ents
                    if e.dxftype() == "LINE" and e.dxf.layer == "8")
@@ -696,7 +700,7 @@ def test_astm_internal_lines_are_the_rulings_of_a_rolled_panel(tmp_path):
 
 
 def test_block_names_and_turning_angles():
-    from patterns.export.dxf import _block_name, _turning
+    from patterns.export.astm import _block_name, _turning
 
     used = set()
     assert _block_name("face 1/a", used) == "face_1_a"
@@ -722,7 +726,7 @@ def test_each_seam_gets_its_own_allowance(tmp_path, corners):
     pattern = flat.placed([(0.0, 300.0 * k, 0.0) for k in range(len(flat.panels))])
     wide = max(pattern.seams, key=lambda fs: fs.length).seam.id  # a 200 mm edge: segments away from its ends
     path = tmp_path / "box.dxf"
-    pattern.to_dxf(path, seam_allowance={None: 5.0, wide: 15.0}, seam_corners=corners)
+    patterns.write(pattern, path, seam_allowance={None: 5.0, wide: 15.0}, seam_corners=corners)
     doc = read(path)
     cuts = _polygons(doc, "CUT")
     shift = drawing_shift(doc.modelspace(), pattern, "SEW")
@@ -748,7 +752,7 @@ def test_squared_corners_of_a_rectangle_are_the_rectangle_grown(tmp_path, allowa
     flat = patterns.flatten(patterns.load(bd.Box(200, 100, 50), max_edge=25))
     pattern = flat.placed([(0.0, 300.0 * k, 0.0) for k in range(len(flat.panels))])
     path = tmp_path / "box.dxf"
-    pattern.to_dxf(path, seam_allowance=allowance, seam_corners="square")
+    patterns.write(pattern, path, seam_allowance=allowance, seam_corners="square")
     doc = read(path)
     cuts = _polygons(doc, "CUT")
     shift = drawing_shift(doc.modelspace(), pattern, "SEW")
@@ -789,7 +793,7 @@ def test_squared_corners_at_a_corner_just_past_thirty_degrees(tmp_path):
     flat = patterns.flatten(patterns.load(prism, max_edge=10))
     pattern = flat.placed([(0.0, 400.0 * k, 0.0) for k in range(len(flat.panels))])
     path = tmp_path / "prism.dxf"
-    pattern.to_dxf(path, seam_allowance=8.0, seam_corners="square")
+    patterns.write(pattern, path, seam_allowance=8.0, seam_corners="square")
     doc = read(path)
     cuts = _polygons(doc, "CUT")
     shift = drawing_shift(doc.modelspace(), pattern, "SEW")
@@ -821,7 +825,7 @@ def test_astm_turn_points_are_the_corners_past_twenty_degrees(tmp_path):
     a hole's cut loop is closed, on layer 11."""
     flat = patterns.flatten(patterns.load(_pentagon_prism([20.5, 75, 85, 90, 89.5]), max_edge=10))
     path = tmp_path / "prism.dxf"
-    flat.to_dxf(path, profile="astm")
+    patterns.write(flat, path, profile="astm")
     doc = read(path)
     pentagons = 0
     for ents in _block_entities(doc).values():
@@ -832,7 +836,7 @@ def test_astm_turn_points_are_the_corners_past_twenty_degrees(tmp_path):
         pentagons += len(ring) == 5
     assert pentagons == 2
     plate = patterns.flatten(patterns.load(bd.Box(200, 100, 50) - bd.Cylinder(20, 50), max_edge=10))
-    plate.to_dxf(path, profile="astm", seam_allowance=5.0)
+    patterns.write(plate, path, profile="astm", seam_allowance=5.0)
     doc = read(path)
     holes = [e for ents in _block_entities(doc).values() for e in ents
              if e.dxftype() == "POLYLINE" and e.dxf.layer == "11"]
@@ -845,7 +849,7 @@ def test_a_notch_a_hair_before_the_end_is_left_out(notched, tmp_path):
     100 mm: 0, 49, 100 (not 98); 50 mm: 0, 50 (not 49) -- on both sides of every seam."""
     pattern = notched["box"]
     path = tmp_path / "box.dxf"
-    pattern.to_dxf(path, notch_spacing=49.0)
+    patterns.write(pattern, path, notch_spacing=49.0)
     expected = {200.0: 5, 100.0: 3, 50.0: 2}
     assert len(_notch_lines(read(path))) == sum(2 * expected[round(fs.length)] for fs in pattern.seams)
 
@@ -872,7 +876,7 @@ def test_corners_where_a_one_segment_seam_has_its_own_allowance(tmp_path, corner
     allowance = {None: 5.0, **{k: 10.0 for k in middle}}
     pattern = flat.placed([(0.0, 300.0 * k, 0.0) for k in range(len(flat.panels))])
     path = tmp_path / "box.dxf"
-    pattern.to_dxf(path, seam_allowance=allowance, seam_corners=corners)
+    patterns.write(pattern, path, seam_allowance=allowance, seam_corners=corners)
     doc = read(path)
     cuts = _polygons(doc, "CUT")
     shift = drawing_shift(doc.modelspace(), pattern, "SEW")
@@ -895,7 +899,7 @@ def test_an_allowance_only_for_the_seams_named(plate, tmp_path):
     get a seam line (SEW) and a cut line outside it; every other panel is cut on its seam line."""
     seam = plate.seams[0].seam
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, seam_allowance={seam.id: 8.0})
+    patterns.write(plate, path, seam_allowance={seam.id: 8.0})
     doc = read(path)
     sews = sorted(ring_numbers(pts) for pts, _ in polylines(doc, "SEW"))
     cuts = sorted(ring_numbers(pts) for pts, _ in polylines(doc, "CUT"))
@@ -910,15 +914,17 @@ def test_an_allowance_only_for_the_seams_named(plate, tmp_path):
 
 
 def test_a_folder_for_the_dxf_is_refused_naming_it(cup, tmp_path):
+    folder = tmp_path / "out.dxf"
+    folder.mkdir()
     with pytest.raises(ExportError, match=r"is a folder; name a file for the DXF file$"):
-        cup.to_dxf(tmp_path)
+        patterns.write(cup, folder)
 
 
 def test_ezdxf_s_time_stamps_are_fixed(cup, tmp_path):
     """The file says which ezdxf wrote it, at a fixed time (2000-01-01): the same pattern gives the
     same bytes tomorrow."""
     path = tmp_path / "cup.dxf"
-    cup.to_dxf(path)
+    patterns.write(cup, path)
     text = path.read_text(encoding="utf-8", errors="replace")
     stamps = re.findall(r"\d+\.\d+\.\d+ @ \d{4}-\d\d-\d\dT[\d:.]+\+00:00", text)
     assert stamps and all(s == f"{ezdxf.__version__} @ 2000-01-01T00:00:00+00:00" for s in stamps)
@@ -929,7 +935,7 @@ def test_an_allowance_grows_the_outline_and_shrinks_the_hole(plate, tmp_path):
     the outlines outwards, the hole's inwards -- every point of each (a loop missing one has
     another area)."""
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, seam_allowance=5.0)
+    patterns.write(plate, path, seam_allowance=5.0)
     found = sorted(ring_numbers(pts) for pts, _ in polylines(read(path), "CUT"))
     expected = []
     for flat in plate.panels:
@@ -950,7 +956,7 @@ def test_a_hole_s_own_allowance_is_drawn(plate, tmp_path):
                          for p, idx in zip(fs.seam.panels, fs.seam.vertices))}
     assert hole_seams
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, seam_allowance={None: 5.0, **{k: 10.0 for k in hole_seams}})
+    patterns.write(plate, path, seam_allowance={None: 5.0, **{k: 10.0 for k in hole_seams}})
     found = sorted(ring_numbers(pts) for pts, _ in polylines(read(path), "CUT"))
     expected = []
     for k in holed:
@@ -973,7 +979,7 @@ def test_a_panel_too_small_to_draw_is_refused_at_any_angle(tmp_path):
     assert np.ptp(uv, axis=0).max() < 0.01 < np.ptp(uv)  # the case: its coordinates span more than it does
     for profile in ("machine", "astm"):
         with pytest.raises(InputError, match=rf"a panel {s * np.sqrt(2):.3g} mm across, under the 0.01 mm"):
-            pattern.to_dxf(tmp_path / "speck.dxf", profile=profile)
+            patterns.write(pattern, tmp_path / "speck.dxf", profile=profile)
     assert not (tmp_path / "speck.dxf").exists()
 
 
@@ -983,7 +989,7 @@ def test_a_full_disk_is_named_and_leaves_nothing(cup, tmp_path, profile):
     small_disk(disk, "24k")
     try:
         with pytest.raises(ExportError, match=r"cup.dxf: cannot write the DXF file \(No space left on device\)"):
-            cup.to_dxf(disk / "cup.dxf", profile=profile)
+            patterns.write(cup, disk / "cup.dxf", profile=profile)
         assert list(disk.iterdir()) == []  # no partial file, no temporary
     finally:
         subprocess.run(["umount", str(disk)], check=False)
@@ -996,7 +1002,7 @@ def test_notches_off_a_corner_are_square_to_the_outline(notched, tmp_path):
     along the corner's bisector)."""
     pattern = notched["box"]
     path = tmp_path / "box.dxf"
-    pattern.to_dxf(path, notch_spacing=1.5)
+    patterns.write(pattern, path, notch_spacing=1.5)
     doc = read(path)
     cuts = _polygons(doc, "CUT")
     near_corners = 0
@@ -1017,7 +1023,7 @@ def test_notches_off_a_corner_are_square_to_the_outline(notched, tmp_path):
 
 
 def test_write_outline_dxf_checks_every_loop_and_writes_them_as_given(tmp_path):
-    from patterns.export.dxf import write_outline_dxf
+    from patterns.export import write_outline_dxf
 
     path = tmp_path / "outline.dxf"
     bad = {"three columns": [[0, 0, 0], [1, 0, 0], [1, 1, 0]], "two points": [[0, 0], [1, 0]],
@@ -1069,7 +1075,7 @@ def test_every_notch_starts_on_the_cut_line_and_points_into_the_piece(notched, t
     running along the cut line."""
     pattern = notched[part]
     path = tmp_path / f"{part}.dxf"
-    pattern.to_dxf(path, seam_allowance=allowance, notch_style=style)
+    patterns.write(pattern, path, seam_allowance=allowance, notch_style=style)
     doc = read(path)
     cuts = _polygons(doc, "CUT")
     sews = _polygons(doc, "SEW") if allowance else cuts
@@ -1096,7 +1102,7 @@ def test_a_v_notch_opens_as_wide_as_it_is_deep(notched, tmp_path, part):
     mouth points on the cut line, as far from the tip as each other, the mouth 10 mm wide along the cut
     line (as wide as the V is deep)."""
     path = tmp_path / f"{part}.dxf"
-    notched[part].to_dxf(path, seam_allowance=10.0, notch_style="v")
+    patterns.write(notched[part], path, seam_allowance=10.0, notch_style="v")
     doc = read(path)
     cuts = _polygons(doc, "CUT")
     lines = _notch_lines(doc)
@@ -1121,7 +1127,7 @@ def test_a_v_notch_opens_as_wide_as_it_is_deep(notched, tmp_path, part):
 def test_every_astm_notch_points_into_the_piece(notched, tmp_path, part, allowance):
     pattern = notched[part]
     path = tmp_path / f"{part}_astm.dxf"
-    pattern.to_dxf(path, profile="astm", seam_allowance=allowance)
+    patterns.write(pattern, path, profile="astm", seam_allowance=allowance)
     doc = read(path)
     count = 0
     for insert in doc.modelspace().query("INSERT"):
@@ -1147,7 +1153,7 @@ def test_the_drawing_starts_in_the_first_quadrant(plate, tmp_path, options):
     from ezdxf import bbox
 
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, **options)
+    patterns.write(plate, path, **options)
     box = bbox.extents(read(path).modelspace())
     scale = patterns.Unit(options.get("units", "mm")).mm
     assert (box.extmin.x * scale, box.extmin.y * scale) == pytest.approx((5.0, 5.0), abs=1e-6)
@@ -1159,7 +1165,7 @@ def test_straight_edges_are_one_segment(notched, tmp_path, options):
     hundreds of mesh points along its edges; ASTM has no curve points on them."""
     pattern = notched["box"]
     path = tmp_path / "box.dxf"
-    pattern.to_dxf(path, **options)
+    patterns.write(pattern, path, **options)
     doc = read(path)
     if options.get("profile") == "astm":
         rings = [e for b in doc.blocks for e in b if e.dxftype() == "POLYLINE"]
@@ -1193,10 +1199,10 @@ def test_no_label_crosses_a_cut_line_or_another_label(labelled, tmp_path, name, 
     """Every TEXT of the machine file (names, strain, seam lengths, bend angles), boxed with ezdxf's
     own font metrics for the standard style at its height and angle, read back: off every CUT and SEW
     line, and off every other label."""
-    from patterns.export.labels import text_box
+    from patterns.pieces.labels import text_box
 
     path = tmp_path / "p.dxf"
-    labelled[name].to_dxf(path, seam_allowance=allowance, bend_spacing=50.0)
+    patterns.write(labelled[name], path, seam_allowance=allowance, bend_spacing=50.0)
     doc = read(path)
     lines = shapely.union_all([shapely.LinearRing(pts) for layer in ("CUT", "SEW")
                                for pts, _ in polylines(doc, layer)])
@@ -1213,7 +1219,7 @@ def test_no_label_crosses_a_cut_line_or_another_label(labelled, tmp_path, name, 
 def test_r12_files_declare_their_units_too(plate, tmp_path, options):
     """R12 predates $INSUNITS and $MEASUREMENT; they are written anyway (Inkscape scales by them)."""
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, **options)
+    patterns.write(plate, path, **options)
     doc = read(path)
     unit = patterns.Unit(options.get("units", "mm"))
     assert doc.dxfversion == "AC1009"
@@ -1224,10 +1230,10 @@ def test_r12_files_declare_their_units_too(plate, tmp_path, options):
 def test_no_astm_label_crosses_a_line_or_another_label(labelled, tmp_path, name):
     """The same for the ASTM profile: the piece text, strain and seam lengths inside each piece block
     and the style text in model space, off the cut and sew lines (layers 1, 14) and off each other."""
-    from patterns.export.labels import text_box
+    from patterns.pieces.labels import text_box
 
     path = tmp_path / "p.dxf"
-    labelled[name].to_dxf(path, profile="astm", seam_allowance=10.0)
+    patterns.write(labelled[name], path, profile="astm", seam_allowance=10.0)
     doc = read(path)
     entities = list(doc.modelspace()) + [e for b in doc.blocks if not b.is_any_layout for e in b]
     lines = shapely.union_all([shapely.LinearRing([tuple(v.dxf.location)[:2] for v in e.vertices])
@@ -1286,7 +1292,7 @@ def test_inkscape_reads_the_machine_profile_at_true_size(notched, tmp_path, part
     from .readers.svg_rings import rings
 
     path = tmp_path / f"{part}.dxf"
-    notched[part].to_dxf(path, **options)
+    patterns.write(notched[part], path, **options)
     svg = _inkscape_svg(path, tmp_path)
     found = sorted(shapely.Polygon(r).area * PX**2 for r in rings(svg, "CUT"))
     scale = patterns.Unit(options.get("units", "mm")).mm
@@ -1299,7 +1305,7 @@ def test_inkscape_reads_the_astm_profile_at_true_size(notched, tmp_path, part):
     from .readers.svg_rings import symbol_rings
 
     path = tmp_path / f"{part}_astm.dxf"
-    notched[part].to_dxf(path, profile="astm", seam_allowance=10.0)
+    patterns.write(notched[part], path, profile="astm", seam_allowance=10.0)
     svg = _inkscape_svg(path, tmp_path)
     doc = read(path)
     for name, ents in _block_entities(doc).items():
@@ -1315,7 +1321,7 @@ def test_inkscape_takes_a_cm_file_for_mm(plate, tmp_path):
     from .readers.svg_rings import rings
 
     path = tmp_path / "plate_cm.dxf"
-    plate.to_dxf(path, units="cm")
+    patterns.write(plate, path, units="cm")
     svg = _inkscape_svg(path, tmp_path)
     found = sum(shapely.Polygon(r).area for r in rings(svg, "CUT")) * PX**2
     assert found == pytest.approx(_cut_area(read(path)), rel=1e-3)  # the numbers as mm: 1/100 of the area
@@ -1338,7 +1344,7 @@ def test_openscad_imports_the_machine_profile_at_true_size(notched, tmp_path, pa
     from .readers.svg_rings import rings
 
     path = tmp_path / f"{part}.dxf"
-    notched[part].to_dxf(path)
+    patterns.write(notched[part], path)
     proc, svg = _openscad_svg(path, tmp_path, "CUT")
     assert proc.returncode == 0, proc.stderr[-2000:]
     union = shapely.union_all([shapely.Polygon(r) for r in rings(svg)])
@@ -1350,7 +1356,7 @@ def test_openscad_cannot_import_polylines(plate, tmp_path, options):
     """The reader table's caveat, measured: OpenSCAD 2021.01 has no POLYLINE, the only polyline R12 and
     ASTM D6673 have, so it imports nothing from them (it names the entity it skips)."""
     path = tmp_path / "plate.dxf"
-    plate.to_dxf(path, **options)
+    patterns.write(plate, path, **options)
     proc, svg = _openscad_svg(path, tmp_path, "1" if options.get("profile") == "astm" else "CUT")
     assert "Unsupported DXF Entity 'POLYLINE'" in proc.stderr or "Unsupported DXF Entity 'INSERT'" in proc.stderr
     assert not svg.exists()  # "not a 2D object": nothing to export
@@ -1364,7 +1370,7 @@ def test_freecad_reads_r12_and_astm_at_true_size(notched, tmp_path, part, option
     _need("freecadcmd")
     path = tmp_path / f"{part}.dxf"
     pattern = notched[part]
-    pattern.to_dxf(path, **options)
+    patterns.write(pattern, path, **options)
     proc = subprocess.run(["freecadcmd", str(READERS / "freecad_layers.py")], capture_output=True, text=True,
                           env=dict(_qt_env(tmp_path), DXF=str(path)), timeout=300)
     lines = [x for x in proc.stdout.splitlines() if "RESULT " in x]
@@ -1392,7 +1398,7 @@ def test_librecad_prints_at_true_size(notched, tmp_path, part, options):
 
     _need("librecad")
     path = tmp_path / f"{part}.dxf"
-    notched[part].to_dxf(path, **options)
+    patterns.write(notched[part], path, **options)
     proc = subprocess.run(["librecad", "dxf2pdf", "--scale", "1", str(path)], capture_output=True, text=True,
                           env=_qt_env(tmp_path), timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
@@ -1431,7 +1437,7 @@ def test_dxf2gcode_reads_the_machine_profile_at_true_size(notched, tmp_path, par
     """dxf2gcode's reader: each CUT contour closed, at the area of the ring ezdxf reads back (in the
     file's unit), and the unit taken from the header: metric for mm, imperial for inches."""
     path = tmp_path / f"{part}.dxf"
-    notched[part].to_dxf(path, **options)
+    patterns.write(notched[part], path, **options)
     found = _dxf2gcode(path, tmp_path)
     expected = sorted(p.area for p in _polygons(read(path), "CUT"))
     assert found["entities"]["CUT"]["closed"] == found["entities"]["CUT"]["contours"] == len(expected)
@@ -1443,7 +1449,7 @@ def test_dxf2gcode_takes_a_cm_file_for_mm(plate, tmp_path):
     """The reader table's caveat, measured: dxf2gcode knows inches ($INSUNITS 1) and millimetres
     ($INSUNITS 4), and takes any other metric file ($MEASUREMENT 1) for millimetres."""
     path = tmp_path / "plate_cm.dxf"
-    plate.to_dxf(path, units="cm")
+    patterns.write(plate, path, units="cm")
     found = _dxf2gcode(path, tmp_path)
     assert found["metric"] is True  # read as mm: 1/10 of the size
     np.testing.assert_allclose(found["entities"]["CUT"]["areas"], sorted(p.area for p in _polygons(read(path), "CUT")),
@@ -1454,7 +1460,7 @@ def test_dxf2gcode_takes_a_cm_file_for_mm(plate, tmp_path):
 def test_dxf2gcode_finds_each_astm_piece_closed(notched, tmp_path, part):
     _need("dxf2gcode")
     path = tmp_path / f"{part}_astm.dxf"
-    notched[part].to_dxf(path, profile="astm", seam_allowance=10.0)
+    patterns.write(notched[part], path, profile="astm", seam_allowance=10.0)
     found = _dxf2gcode(path, tmp_path)
     pieces = {name: layers for name, layers in found["blocks"].items() if not name.startswith("$")}
     assert sorted(pieces) == sorted(flat.name for flat in notched[part].panels)
@@ -1473,7 +1479,7 @@ def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance
     """Notches every 40 mm of seam (not only at the ends, where the outline has corners), and with an
     allowance that changes from seam to seam (5 mm, 15 mm along the longest): each starts on the cut
     line and runs into the piece, square to its seam, within the allowance."""
-    from patterns.export.dxf import notch_positions
+    from patterns.pieces.notches import notch_positions
 
     pattern = notched[part]
     pattern = pattern.placed([(0.0, 1000.0 * k, 0.0) for k in range(len(pattern.panels))])
@@ -1481,7 +1487,7 @@ def test_notches_along_the_seams_point_in_too(notched, tmp_path, part, allowance
         longest = max(pattern.seams, key=lambda fs: fs.length).seam.id
         allowance = {None: 5.0, longest: 15.0}
     path = tmp_path / f"{part}.dxf"
-    pattern.to_dxf(path, seam_allowance=allowance, notch_spacing=40.0)
+    patterns.write(pattern, path, seam_allowance=allowance, notch_spacing=40.0)
     doc = read(path)
     cuts = _pieces(doc, "CUT")  # with their holes: notches on a hole's seam start on the hole's cut line
     sews = _pieces(doc, "SEW") if allowance else cuts

@@ -191,7 +191,7 @@ def test_random_disk_meshes(tmp_path_factory, seed, bump, n):
     assert np.all(np.isfinite(result.uv))
     assert result.n_folded == 0 and result.one_to_one
     path = tmp_path_factory.mktemp("dxf") / "disk.dxf"
-    from patterns.export.dxf import write_outline_dxf
+    from patterns.export import write_outline_dxf
 
     write_outline_dxf(path, [result.uv[loop] for loop in result.loops])
     doc, auditor = recover.readfile(path)

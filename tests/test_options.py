@@ -48,7 +48,7 @@ def test_dxf_lengths_must_be_finite(tmp_path, option):
     pattern = patterns.flatten(patterns.load(SAMPLES / "hopper.step"))
     out = tmp_path / "x.dxf"
     with pytest.raises(InputError, match=option):
-        pattern.to_dxf(out, **{option: float("inf")})
+        patterns.write(pattern, out, **{option: float("inf")})
     assert not out.exists()
 
 
@@ -62,12 +62,14 @@ from patterns import cli  # noqa: E402
 from patterns.options import cli_flags, from_arguments  # noqa: E402
 
 RECORDS = {"load": patterns.LoadOptions, "flatten": patterns.FlattenOptions, "check": patterns.CheckOptions,
-           "dxf": patterns.DxfOptions, "nest": patterns.NestOptions, "batch": patterns.BatchOptions}
-COMMANDS = {"flatten": ("load", "flatten", "check", "dxf", "nest"),
-            "batch": ("load", "flatten", "check", "dxf", "nest", "batch"),
+           "pieces": patterns.PieceOptions, "write": patterns.WriteOptions, "nest": patterns.NestOptions,
+           "batch": patterns.BatchOptions, "unfold": patterns.UnfoldOptions}
+COMMANDS = {"flatten": ("load", "flatten", "check", "pieces", "write", "nest"),
+            "batch": ("load", "flatten", "unfold", "check", "pieces", "write", "nest", "batch"),
+            "unfold": ("unfold", "pieces", "write", "nest"),
             "check": ("load", "flatten", "check"), "info": ("load",)}
-FROM_OTHER_FLAGS = {("nest", "margin")}
-"""Options the command line does not take as flags of their own: the nesting margin is the largest --seam-allowance."""
+FROM_OTHER_FLAGS = {("pieces", name) for name in cli._PATTERN_ONLY}
+"""Options a command does not take: a blank has no seams, rulings or strain (``patterns unfold``)."""
 
 
 def _subparser(command):
@@ -82,7 +84,7 @@ def test_every_api_option_has_its_cli_flag(command):
     flags = {s for a in _subparser(command)._actions for s in a.option_strings}
     for key in COMMANDS[command]:
         missing = {name: flag for name, flag in cli_flags(RECORDS[key]).items()
-                   if flag not in flags and (key, name) not in FROM_OTHER_FLAGS}
+                   if flag not in flags and not (command == "unfold" and (key, name) in FROM_OTHER_FLAGS)}
         assert not missing, f"patterns {command} lacks flags for {RECORDS[key].__name__}: {missing}"
 
 
@@ -93,7 +95,7 @@ CLI_VALUES = [  # (flag and text, record, the API's keyword and value)
     (["--no-sew"], "load", "sew", False),
     (["--weld-vertices", "no"], "load", "weld_vertices", False),
     (["--units", "in"], "load", "units", "in"),
-    (["--units", "in"], "dxf", "units", "in"),
+    (["--units", "in"], "write", "units", "in"),
     (["--method", "isometric"], "flatten", "method", "isometric"),
     (["--no-exact"], "flatten", "exact", False),
     (["--grain", "0,0,2"], "flatten", "grain", (0.0, 0.0, 1.0)),  # a direction, normalised
@@ -103,12 +105,12 @@ CLI_VALUES = [  # (flag and text, record, the API's keyword and value)
     (["--energy-tolerance", "1e-7"], "flatten", "energy_tolerance", 1e-7),
     (["--max-strain", "0.05"], "check", "max_strain", 0.05),
     (["--max-seam-mismatch", "0.5"], "check", "max_seam_mismatch", 0.5),
-    (["--profile", "astm"], "dxf", "profile", "astm"),
-    (["--dxf-version", "R12"], "dxf", "version", "R12"),
-    (["--strain-layer"], "dxf", "strain_layer", True),
-    (["--text-height", "4"], "dxf", "text_height", 4.0),
-    (["--notch-style", "v"], "dxf", "notch_style", "v"),
-    (["--seam-corners", "square"], "dxf", "seam_corners", "square"),
+    (["--profile", "astm"], "write", "profile", "astm"),
+    (["--dxf-version", "R12"], "write", "version", "R12"),
+    (["--strain-layer"], "pieces", "strain_layer", True),
+    (["--text-height", "4"], "pieces", "text_height", 4.0),
+    (["--notch-style", "v"], "pieces", "notch_style", "v"),
+    (["--seam-corners", "square"], "pieces", "seam_corners", "square"),
     (["--roll-width", "1500"], "nest", "width", 1500.0),
     (["--sheet", "2500x1250"], "nest", "sheet", (2500.0, 1250.0)),
     (["--nest-gap", "5"], "nest", "gap", 5.0),
@@ -118,6 +120,9 @@ CLI_VALUES = [  # (flag and text, record, the API's keyword and value)
     (["--quantity", "face0=3", "--quantity", "face1=2"], "nest", "quantities", {"face0": 3, "face1": 2}),
     (["--nest-time", "3"], "nest", "time_limit", 3),
     (["--nest-seed", "7"], "nest", "seed", 7),
+    (["--margin", "0.2"], "nest", "margin", 0.2),
+    (["--no-bend-lines"], "write", "bend_lines", False),
+    (["--layer-map", "updown"], "write", "layer_map", patterns.export.layer_map("updown")),
     (["--no-nest-cache"], "nest", "cache", False),
     (["--crease-angle", "45"], "load", "crease_angle", 45.0),
     (["--area-tolerance", "0.1"], "check", "area_tolerance", 0.1),
@@ -128,7 +133,7 @@ BATCH_VALUES = [
     (["--jobs", "3"], "jobs", 3), (["--scheduler", "tcp://h:8786"], "scheduler", "tcp://h:8786"),
     (["--timeout", "30"], "timeout", 30.0), (["--memory", "2048"], "memory", 2048.0), (["--wait", "5"], "wait", 5.0),
     (["--no-report"], "report", False), (["--preview"], "preview", True), (["--heat-map"], "heat_map", True),
-    (["--quiet"], "quiet", True),
+    (["--quiet"], "quiet", True), (["--unfold"], "unfold", True),
 ]
 
 
@@ -170,11 +175,11 @@ def test_unknown_keywords_name_the_options():
         patterns.CheckOptions.of(None, {"max_strian": 0.1})
     pattern = patterns.flatten(patterns.load(SAMPLES / "hopper.step"))
     with pytest.raises(InputError, match="unknown option 'seam_alowance'"):
-        pattern.to_dxf("never.dxf", seam_alowance=3)
+        patterns.write(pattern, "never.dxf", seam_alowance=3)
 
 
 def test_records_are_frozen_and_documented():
-    record = patterns.DxfOptions(units="in")
+    record = patterns.WriteOptions(units="in")
     with pytest.raises(dataclasses.FrozenInstanceError):
         record.units = "mm"
     for cls in RECORDS.values():

@@ -767,8 +767,8 @@ def test_picture_resolutions_are_bounded(here, dpi):
     pattern = patterns.flatten(patterns.load(here / "dish.obj"))
     before = snapshot(here)
     with pytest.raises(patterns.InputError, match="dpi must be a number between"):
-        pattern.heat_map(here / "h.png", dpi=dpi)
-    pattern.to_dxf(here / "d.dxf")
+        patterns.heat_map(pattern, here / "h.png", dpi=dpi)
+    patterns.write(pattern, here / "d.dxf")
     with pytest.raises(patterns.InputError, match="dpi must be a number between"):
         patterns.preview_dxf(here / "d.dxf", here / "p.png", dpi=dpi)
     assert set(snapshot(here)) == set(before) | {b"d.dxf"}

@@ -11,7 +11,7 @@ import shapely
 
 import patterns
 from patterns.errors import InputError
-from patterns.export.arcs import arc_points, fit_arcs
+from patterns.pieces.arcs import arc_points, fit_arcs
 
 from .conftest import SAMPLES
 
@@ -78,7 +78,7 @@ def test_cone_frustum_blank_is_the_analytic_annular_sector(hopper, tmp_path, arc
     flat = hopper.panels[0]
     assert flat.flattening.method == "exact"
     path = tmp_path / "hopper.dxf"
-    hopper.to_dxf(path, arcs=arcs)
+    patterns.write(hopper, path, arcs=arcs)
     (contour, segments), = dxf_cut_contours(path)
     # The file holds the drawing moved into the first quadrant: move it back by the same shift
     # (lower-left corners of the contour and of the flattened outline; the arcs' sag < 0.01 mm).
@@ -119,7 +119,7 @@ def test_rolled_cylinder_blank_length_with_thickness_and_k_factor(tmp_path):
     assert width == pytest.approx(2 * pi * (250.0 + 0.44 * 2.0), abs=0.01)
     assert np.ptp(flat.uv[:, 1]) == pytest.approx(500.0, abs=1e-9)
     path = tmp_path / "cylinder.dxf"
-    pattern.to_dxf(path, arcs=True)
+    patterns.write(pattern, path, arcs=True)
     (contour, segments), = dxf_cut_contours(path, step=0.5)
     x0, y0 = contour.min(axis=0)
     rect = np.array([[x0, y0], [x0 + width, y0], [x0 + width, y0 + 500], [x0, y0 + 500]])
@@ -192,7 +192,7 @@ def test_bend_lines_on_the_bend_layer(hopper, tmp_path):
         assert np.linalg.norm(a) == pytest.approx(R1 / SIN_A, abs=0.01)
         assert np.linalg.norm(b) == pytest.approx(R2 / SIN_A, abs=0.01)
     path = tmp_path / "hopper.dxf"
-    hopper.to_dxf(path, bend_spacing=60.0)
+    patterns.write(hopper, path, bend_spacing=60.0)
     doc = ezdxf.readfile(path)
     assert len(doc.modelspace().query('LINE[layer=="BEND"]')) == 30
     texts = [t.dxf.text for t in doc.modelspace().query('TEXT[layer=="BEND"]')]
@@ -231,11 +231,11 @@ def test_bad_sheet_options(kwargs, words):
 
 def test_bad_dxf_sheet_options(hopper, tmp_path):
     with pytest.raises(InputError, match="arc_tolerance"):
-        hopper.to_dxf(tmp_path / "a.dxf", arcs=True, arc_tolerance=0)
+        patterns.write(hopper, tmp_path / "a.dxf", arcs=True, arc_tolerance=0)
     with pytest.raises(InputError, match="bend_spacing"):
-        hopper.to_dxf(tmp_path / "a.dxf", bend_spacing=-5)
+        patterns.write(hopper, tmp_path / "a.dxf", bend_spacing=-5)
     with pytest.raises(InputError, match="machine profile only"):
-        hopper.to_dxf(tmp_path / "a.dxf", profile="astm", arcs=True)
+        patterns.write(hopper, tmp_path / "a.dxf", profile="astm", arcs=True)
     assert list(tmp_path.iterdir()) == []
 
 
@@ -312,7 +312,7 @@ def test_square_to_round_is_unrolled_exactly_like_the_hand_layout(tmp_path):
         d = shapely.distance(shapely.points(uv[curve_pts]), shapely.LineString(hand))
         assert d.max() < 0.05  # mm, on a 500 mm part (measured: round-off)
     path = tmp_path / "s2r.dxf"
-    pattern.to_dxf(path, bend_spacing=50.0)
+    patterns.write(pattern, path, bend_spacing=50.0)
     bend = ezdxf.readfile(path).modelspace().query('LINE[layer=="BEND"]')
     lines = [r for f in pattern.panels for r in f.rulings(50.0)]
     assert len(bend) == len(lines) > 0

@@ -27,6 +27,8 @@ import patterns
 from patterns.cli import main
 from patterns.comparison import _resample
 
+from .helpers import is_dashed
+
 SHEETMETAL = Path(__file__).resolve().parent.parent.parent / "shared" / "sheetmetal"
 READERS = Path(__file__).resolve().parent / "readers"
 PARTS = {  # SolidWorks' figures from ../shared/sheetmetal/README.md: area mm², outer perimeter mm, holes, bend lines
@@ -132,7 +134,7 @@ def test_conical_bend_unfolds_to_its_neutral_sector():
     assert blank.bends[0].allowance == pytest.approx(phi * (s_a + s_b) / 2, rel=1e-9)
     # The cone has a flat face on one side only: a warning, and the blank is still cut.
     (warning,) = blank.findings
-    assert warning.code is patterns.BlankCode.BEND_WITHOUT_FLANGE and not warning.error and blank.ok
+    assert warning.code is patterns.Code.BEND_WITHOUT_FLANGE and not warning.error and blank.ok
 
 
 def test_a_bend_that_is_no_cylinder_is_meshed_and_says_so():
@@ -161,7 +163,7 @@ def test_a_bend_that_is_no_cylinder_is_meshed_and_says_so():
     assert max(blank.size) == pytest.approx(length, abs=0.05)  # the mesh's chords and relaxation: < 0.05 mm
     assert blank.area == pytest.approx(length * width, rel=5e-4)
     (finding,) = blank.findings
-    assert finding.code is patterns.BlankCode.MESHED_FACE and not finding.error and blank.ok
+    assert finding.code is patterns.Code.MESHED_FACE and not finding.error and blank.ok
     assert "meshed" in finding.message and "strain up to" in finding.message
 
 
@@ -216,9 +218,9 @@ def test_flanges_that_land_on_the_plate_are_an_error_and_no_dxf(tmp_path):
     part = strip + frame
     blank = patterns.unfold(part)
     assert not blank.ok
-    assert [f.code for f in blank.findings if f.error] == [patterns.BlankCode.FLANGES_OVERLAP]
+    assert [f.code for f in blank.findings if f.error] == [patterns.Code.FLANGES_OVERLAP]
     with pytest.raises(patterns.ExportError, match="not written"):
-        blank.to_dxf(tmp_path / "x.dxf")
+        patterns.write(blank, tmp_path / "x.dxf")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -234,7 +236,7 @@ def strip_blank():
 
 def test_dxf_holds_the_blank_and_its_bend_lines(strip_blank, tmp_path):
     path = tmp_path / "blank.dxf"
-    strip_blank.to_dxf(path)
+    patterns.write(strip_blank, path)
     doc = ezdxf.readfile(path)
     assert doc.header["$INSUNITS"] == 4 and doc.header["$MEASUREMENT"] == 1
     msp = doc.modelspace()
@@ -242,10 +244,16 @@ def test_dxf_holds_the_blank_and_its_bend_lines(strip_blank, tmp_path):
     assert outline.closed
     (circle,) = msp.query("CIRCLE[layer=='CUT']")
     assert circle.dxf.radius == pytest.approx(4.0, abs=1e-12)
-    assert len(msp.query("LINE[layer=='BEND']")) == 1
-    assert doc.layers.get("BEND").dxf.linetype == "CENTER"
+    (bend,) = msp.query("LINE[layer=='BEND']")
+    linetype = doc.layers.get("BEND").dxf.linetype  # dashed: a pattern of dashes and gaps
+    assert is_dashed(doc, linetype)
     texts = [t.dxf.text for t in msp.query("TEXT[layer=='BEND']")]
     assert texts == ["UP 90.0 DEG R2"]
+    # on its line, from the bend's own line moved as the drawing moved the blank (5 mm from the axes)
+    x0, y0 = strip_blank.polygon.bounds[:2]
+    expected = strip_blank.bends[0].line + [5.0 - x0, 5.0 - y0]
+    got = np.array([bend.dxf.start, bend.dxf.end])[:, :2]
+    assert np.abs(got - expected).max() < 1e-9 or np.abs(got[::-1] - expected).max() < 1e-9
     read = patterns.read_flat_pattern(path)
     assert read.area == pytest.approx(strip_blank.area, rel=1e-6)
     assert read.perimeter == pytest.approx(strip_blank.perimeter, rel=1e-9)
@@ -260,7 +268,7 @@ def test_librecad_renders_a_real_blank(tmp_path):
     _need_parts()
     blank = patterns.unfold(SHEETMETAL / "MMP.05.00.00.001_Support.STEP", k_factor=K)
     path = tmp_path / "support.dxf"
-    blank.to_dxf(path)
+    patterns.write(blank, path)
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(tmp_path), HOME=str(tmp_path))
     proc = subprocess.run(["librecad", "dxf2pdf", "--fit", str(path)], capture_output=True, text=True, env=env,
                           timeout=120)
@@ -268,7 +276,7 @@ def test_librecad_renders_a_real_blank(tmp_path):
     data = (tmp_path / "support.pdf").read_bytes()
     content = b"".join(_inflate(s) for s in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, re.DOTALL))
     # Drawn as vector paths: at least one line-to for every straight piece of the outline.
-    straight = sum(1 for piece in blank.outline.pieces if isinstance(piece, patterns.blank.Line))
+    straight = sum(1 for piece in blank.outline.pieces if isinstance(piece, patterns.curves.Line))
     assert len(re.findall(rb"\sl\s", content)) >= straight
 
 
@@ -283,7 +291,7 @@ def test_dxf2gcode_reads_closed_contours(strip_blank, tmp_path):
     if shutil.which("dxf2gcode") is None:
         pytest.skip("dxf2gcode is not installed (.ci/run installs it with apt-get)")
     path = tmp_path / "blank.dxf"
-    strip_blank.to_dxf(path)
+    patterns.write(strip_blank, path)
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(tmp_path), HOME=str(tmp_path))
     proc = subprocess.run(["/usr/bin/python3", str(READERS / "dxf2gcode_contours.py"), str(path)],
                           capture_output=True, text=True, env=env, timeout=120)
@@ -302,7 +310,7 @@ def test_freecad_reads_the_blank_closed_at_its_area(strip_blank, tmp_path):
     if shutil.which("freecadcmd") is None:
         pytest.skip("freecadcmd is not installed (.ci/run installs it with apt-get)")
     path = tmp_path / "blank.dxf"
-    strip_blank.to_dxf(path)
+    patterns.write(strip_blank, path)
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=str(tmp_path), HOME=str(tmp_path),
                DXF=str(path))
     proc = subprocess.run(["freecadcmd", str(READERS / "freecad_layers.py")], capture_output=True, text=True,
@@ -363,10 +371,15 @@ def test_each_part_unfolds_through_the_command_line(tmp_path, capsys):
                  "--report", str(report), "--compare", str(SHEETMETAL / f"{part}.DXF")])
     assert code == 0
     data = json.loads(report.read_text())
-    assert data["holes"] == 22 and len(data["bends"]) == 3
+    (blank,) = data["blanks"]
+    assert blank["holes"] == 22 and len(blank["bends"]) == 3 and data["ok"]
     assert data["comparison"]["hausdorff_mm"] <= 0.1
     read = patterns.read_flat_pattern(out)
-    assert read.area == pytest.approx(data["area_mm2"], rel=1e-4)
+    assert read.area == pytest.approx(blank["area_mm2"], rel=1e-4)
+    (piece,) = data["pieces"]  # the report's blank is the DXF's, line for line
+    assert read.area == pytest.approx(piece["area_mm2"], rel=1e-4)
+    assert np.abs(np.array(read.bend_lines).reshape(-1, 4).min(axis=0)
+                  - np.array([b["line"] for b in piece["bends"]]).reshape(-1, 4).min(axis=0)).max() < 0.01
     assert "Hausdorff" in capsys.readouterr().out
 
 
@@ -380,3 +393,94 @@ def test_command_line_refuses_bad_input_in_one_line_and_writes_nothing(tmp_path,
         assert err.count("\n") == 1 and err.startswith("patterns: error: ")
     assert main(["unfold", str(step), "-o", str(step)]) == 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["strip.step"]
+
+
+# --------------------------------------------------------------------------- #
+# Blanks are pieces: nested, written by every profile, checked, batched
+# --------------------------------------------------------------------------- #
+
+
+def _cut_polygons(path, layer="CUT"):
+    """Every cut outline of a DXF read back, with the holes inside it (ezdxf's paths, 0.001 mm chords)."""
+    from ezdxf import path as ezpath
+
+    doc = ezdxf.readfile(path)
+    rings = []
+    for e in doc.modelspace().query(f"LWPOLYLINE CIRCLE[layer=='{layer}']"):
+        pts = np.array([(v.x, v.y) for v in ezpath.make_path(e).flattening(0.001)])
+        rings.append(shapely.Polygon(pts))
+    outers = [r for r in rings if not any(o is not r and o.contains(r) for o in rings)]
+    return doc, [shapely.Polygon(o.exterior, [r.exterior for r in rings if r is not o and o.contains(r)])
+                 for o in outers]
+
+
+def test_unfold_nests_six_blanks_on_sheets_read_back(tmp_path, capsys):
+    """``patterns unfold PART -o nest.dxf --sheet 600x400 --copies 6``: six blanks, each the blank's area,
+    pairwise disjoint (10 mm apart) and inside their sheets, from the DXF read back with shapely; the
+    report's bend lines lie on the DXF's."""
+    step = tmp_path / "strip.step"
+    bd.export_step(bent_strip(hole=4.0), str(step))
+    blank = patterns.unfold(step, k_factor=0.5)
+    out, report = tmp_path / "nest.dxf", tmp_path / "nest.json"
+    code = main(["unfold", str(step), "-o", str(out), "--sheet", "600x400", "--copies", "6", "--nest-time", "1",
+                 "--no-nest-cache", "--report", str(report)])
+    assert code == 0, capsys.readouterr()
+    doc, blanks = _cut_polygons(out)
+    assert len(blanks) == 6
+    assert all(b.area == pytest.approx(blank.area, rel=1e-5) and len(b.interiors) == 1 for b in blanks)
+    assert all(blanks[i].distance(blanks[j]) >= 10.0 - 1e-6 for i in range(6) for j in range(i + 1, 6))
+    sheets = [shapely.Polygon(np.array(e.get_points("xy"))) for e in doc.modelspace().query("LWPOLYLINE[layer=='STOCK']")]
+    assert sheets and all(s.area == pytest.approx(600.0 * 400.0) for s in sheets)
+    assert all(any(s.buffer(1e-6).contains(b) for s in sheets) for b in blanks)
+    data = json.loads(report.read_text())
+    bends = [np.array(e.dxf.start)[:2] for e in doc.modelspace().query("LINE[layer=='BEND']")]
+    reported = [np.array(b["line"][0]) for p in data["pieces"] for b in p["bends"]]
+    assert len(reported) == len(bends) == 6
+    assert all(min(np.linalg.norm(bends - r, axis=1)) < 0.01 for r in reported)
+
+
+def test_blanks_and_pattern_pieces_nest_together():
+    """layout() of a blank, and of a blank with a pattern: every piece on the sheet, none touching."""
+    blank = patterns.unfold(bent_strip(hole=4.0), k_factor=0.5)
+    nest = patterns.layout(blank, sheet=(500.0, 250.0), copies=3, time_limit=1, cache=False)
+    assert [p.name for p in nest.pieces] == ["part", "part #2", "part #3"]
+    box = patterns.flatten(patterns.load(bd.Box(100, 60, 20), max_edge=20))
+    mix = patterns.layout([box, blank], sheet=(500.0, 250.0), time_limit=1, cache=False)
+    assert len(mix.pieces) == 7 and {p.source.kind for p in mix.pieces} == {"panel", "blank"}
+    polys = [p.polygon for p in mix.pieces]
+    assert all(polys[i].distance(polys[j]) >= 10.0 - 1e-6 for i in range(7) for j in range(i + 1, 7))
+    (sheet,) = mix.stock
+    assert shapely.box(*sheet).buffer(1e-6).contains(shapely.union_all(polys))
+
+
+@pytest.mark.parametrize("name", ["L", "U", "Z"])
+def test_exact_brackets_are_ok_everywhere(name, tmp_path, capsys):
+    """A 2 mm L, U and Z bracket, inside radius 3 mm, a hole in a flange, drawn in build123d (a rectangle
+    swept along the filleted profile): flattened face by face every panel is an exact development and every
+    seam is its exact length on both sides (a bend's end arc against the arc's chords no more), so
+    ``patterns check`` says ok; unfolded, the blank is the flanges plus the bends' allowances."""
+    t, r, width = 2.0, 3.0, 40.0
+    profile = {"L": [(60, 0), (0, 0), (0, 40)], "U": [(50, 30), (50, 0), (0, 0), (0, 30)],
+               "Z": [(-40, 0), (0, 0), (0, 30), (40, 30)]}[name]
+    with bd.BuildLine() as line:
+        bd.FilletPolyline(*profile, radius=r + t / 2)
+    path = line.wire()
+    plane = bd.Plane(origin=path.position_at(0), x_dir=(0, 0, 1), z_dir=path.tangent_at(0))
+    part = bd.sweep(plane * bd.Rectangle(width, t), path=path, transition=bd.Transition.RIGHT)
+    (x0, y0), (x1, y1) = profile[:2]  # a hole through the first flange, in its middle
+    drill = bd.Plane(origin=((x0 + x1) / 2, (y0 + y1) / 2, 0), z_dir=(y0 - y1, x1 - x0, 0)) * bd.Cylinder(4, 50)
+    part = part - drill
+    step = tmp_path / f"{name}.step"
+    bd.export_step(part, str(step))
+    assert main(["check", str(step)]) == 0
+    assert f"{name}.step: ok" in capsys.readouterr().out
+    pattern = patterns.flatten(patterns.load(step))
+    for fs in pattern.seams:
+        assert fs.flat_lengths == pytest.approx((fs.length, fs.length), rel=1e-9)
+    blank = patterns.unfold(step, k_factor=0.47)
+    straight = sum(np.linalg.norm(np.subtract(a, b)) for a, b in zip(profile[:-1], profile[1:]))
+    bends = len(profile) - 2
+    # each flange shortened by (r + t/2) at a bend, each bend adds its neutral arc (r + K t) pi / 2
+    expected = straight - 2 * bends * (r + t / 2) + bends * np.pi / 2 * (r + 0.47 * t)
+    assert max(blank.size) == pytest.approx(expected, abs=1e-6) and min(blank.size) == pytest.approx(width)
+    assert len(blank.holes) == 1 and blank.holes[0].is_circle and len(blank.bends) == len(profile) - 2

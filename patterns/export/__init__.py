@@ -1,9 +1,24 @@
-"""Writing results: DXF cutting patterns, flat meshes, heat maps, always atomically."""
+"""Writers: every file ``patterns`` writes, always atomically.
+
+:func:`write` (:mod:`~patterns.export.profiles`) writes pieces through a
+registry of profiles, one module each: :mod:`~patterns.export.machine` (DXF
+for cutters), :mod:`~patterns.export.astm` (DXF ASTM D6673),
+:mod:`~patterns.export.svg`, :mod:`~patterns.export.report` (JSON).  Besides
+them: the strain heat map of a pattern (:mod:`~patterns.export.heatmap`), the
+1:1 preview of a written DXF (:mod:`~patterns.export.preview`), a one-panel
+flat mesh (:mod:`~patterns.export.mesh`) and bare flat loops
+(:func:`~patterns.export.dxfdoc.write_outline_dxf`).
+"""
 
 from ..files import atomic_output
-from .dxf import write_outline_dxf, write_pattern_dxf
+from .dxfdoc import write_outline_dxf
 from .heatmap import heat_map
+from .layers import LayerMap, layer_map
 from .mesh import write_flat_obj
+from .options import WriteOptions
 from .preview import preview_dxf
+from .profiles import write
+from .registry import Profile, profiles, register
 
-__all__ = ["atomic_output", "heat_map", "preview_dxf", "write_flat_obj", "write_outline_dxf", "write_pattern_dxf"]
+__all__ = ["LayerMap", "Profile", "WriteOptions", "atomic_output", "heat_map", "layer_map", "preview_dxf", "profiles",
+           "register", "write", "write_flat_obj", "write_outline_dxf"]

@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import InputError
 from ..files import atomic_output
 from ..options import check_number
+from ..pieces.drawing import row_offsets
 from ..text import printable
 
 __all__ = ["HEAT_MAP_FORMATS", "display_offsets", "heat_map"]
@@ -23,32 +24,12 @@ HEAT_MAP_FORMATS = (".png", ".svg")
 """File suffixes :func:`heat_map` writes."""
 
 
-def display_offsets(pattern, *, gap: float | None = None, margin: float = 0.0) -> np.ndarray:
-    """Where to put each panel when the pattern is not laid out: rows of bounding boxes.
-
-    For pictures and for DXF files of a pattern that was never laid out: only
-    translations, nothing scaled or turned; the pattern itself is not changed.
-    ``margin`` (mm) is added around every box (room for a seam allowance).
-    Returns ``(k, 2)`` mm offsets (all zero once the pattern is laid out: then
-    its placement is used).
-    """
-    panels = pattern.panels
+def display_offsets(pattern, *, gap: float | None = None) -> np.ndarray:
+    """Where to put each panel of a pattern that is not laid out, for a picture: rows of bounding boxes
+    (:func:`patterns.pieces.drawing.row_offsets`), ``(k, 2)`` mm; all zero once the pattern is laid out."""
     if pattern.laid_out:
-        return np.zeros((len(panels), 2))
-    boxes = np.array([np.r_[p.uv.min(axis=0) - margin, p.uv.max(axis=0) + margin] for p in panels])
-    sizes = boxes[:, 2:] - boxes[:, :2]
-    if gap is None:
-        gap = 0.08 * float(np.max(sizes))
-    width = max(float(np.sqrt((sizes[:, 0] + gap) @ (sizes[:, 1] + gap)) * 1.6), float(sizes[:, 0].max()))
-    offsets = np.zeros((len(panels), 2))
-    x = y = row = 0.0
-    for i, (w, h) in enumerate(sizes):
-        if x > 0 and x + w > width:
-            x, y, row = 0.0, y - row - gap, 0.0
-        offsets[i] = (x - boxes[i, 0], y - boxes[i, 3])
-        x += w + gap
-        row = max(row, h)
-    return offsets
+        return np.zeros((len(pattern.panels), 2))
+    return row_offsets([np.r_[p.uv.min(axis=0), p.uv.max(axis=0)] for p in pattern.panels], gap=gap)
 
 
 def heat_map(pattern, path, *, max_strain: float | None = None, title: str | None = None, dpi: int = 150) -> None:

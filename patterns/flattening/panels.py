@@ -119,9 +119,9 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     seams_out = []
     edges = [unique_edges(fp.faces) for fp in flat]  # once per panel, not per seam side
     for seam in model.seams:
-        lengths = tuple(_flat_length(flat[p].flattening, edges[p], idx) for p, idx in zip(seam.panels, seam.vertices))
+        lengths = tuple(_flat_length(flat[p], edges[p], idx, seam) for p, idx in zip(seam.panels, seam.vertices))
         held_at = tuple(targets.get((seam.id, side)) for side in range(2))
-        seams_out.append(FlatSeam(seam, lengths, None if None in held_at else held_at))
+        seams_out.append(FlatSeam(seam, lengths, None if held_at == (None, None) else held_at))
     return Pattern(model=model, panels=tuple(flat), seams=tuple(seams_out), method=method,
                    thickness=opts.thickness, k_factor=opts.k_factor, reference=opts.reference,
                    max_strain=opts.max_strain)
@@ -152,9 +152,21 @@ def _split_into_gores(model: Model, opts: FlattenOptions, offset: float, keep: s
     return model
 
 
-def _flat_length(result: Flattening, edges: np.ndarray, idx) -> float:
-    """Flat length of a seam side given by its vertices, segment by segment along the mesh's ``edges``."""
+def _flat_length(flat: FlatPanel, edges: np.ndarray, idx, seam) -> float:
+    """Flat length of a seam side given by its vertices.
+
+    A side of an exact development is measured on its true curve: the development is an isometry of the
+    surface it unrolls, so the curve lies flat as long as it is on that surface -- the seam's exact (CAD)
+    length, scaled by how much longer its polyline is on the neutral surface than on the skin when a
+    thickness moved it there.  (The polyline through its points is shorter by the chords' sag, in 3D and
+    flat alike, but not by the same amount: a cylinder's end arc lies flat as a straight line.)  Any other
+    side is the flat polyline's length, segment by segment along the mesh's ``edges``.
+    """
+    result = flat.flattening
     idx = np.asarray(idx, dtype=np.int64)
+    if result.method == "exact":
+        skin = polyline_length(flat.panel.vertices[idx])
+        return float(seam.length * (polyline_length(result.vertices[idx]) / skin if skin > 0 else 1.0))
     pairs = seam_edges(result.vertices, edges, np.column_stack([idx[:-1], idx[1:]]))
     return float(np.linalg.norm(result.uv[pairs[:, 1]] - result.uv[pairs[:, 0]], axis=1).sum())
 
@@ -163,10 +175,11 @@ def _side_targets(model, panel: int, result: Flattening, eased: dict, mode) -> d
     """``{(seam id, side): flat length the side should have}`` for the seams of one flattened panel.
 
     The 3D length of the side's polyline (on the surface that was flattened)
-    times its ease, where the length was held (seams "true") or kept by an
-    exact development; nothing for a free seam.
+    times its ease, where the length was held (seams "true" or "total"); nothing
+    for a free seam, nor for an exact development (an isometry: nothing is
+    held, every length is kept).
     """
-    if mode is SeamLengths.FREE or result.method not in ("relaxed", "exact"):
+    if mode is SeamLengths.FREE or result.method != "relaxed":
         return {}
     out = {}
     for seam in model.seams_of(panel):

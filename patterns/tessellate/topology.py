@@ -55,6 +55,11 @@ class Topology:
     edge_faces : tuple
         Per edge, the faces whose wires use it (a face twice along its own
         seam line).
+    edge_vertices : tuple
+        Per edge, ``(first, last)``: the numbers of its end vertices (each
+        vertex of the shape numbered once, in first-seen order), in the edge's
+        own direction; a wire that walks it reversed goes from ``last`` to
+        ``first``.
     """
 
     name: str
@@ -63,6 +68,7 @@ class Topology:
     degenerate: tuple
     wires: tuple
     edge_faces: tuple
+    edge_vertices: tuple = ()
 
 
 def read_topology(shape, *, name: str) -> Topology:
@@ -70,7 +76,7 @@ def read_topology(shape, *, name: str) -> Topology:
     from OCP.BRep import BRep_Tool
     from OCP.BRepTools import BRepTools_WireExplorer
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_WIRE
-    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopExp import TopExp, TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
     faces = []
@@ -113,9 +119,12 @@ def read_topology(shape, *, name: str) -> Topology:
         for walk in walks:
             for e, _ in walk:
                 edge_faces[e].append(k)
+    vertices = _Registry()
+    ends = tuple((vertices.index(TopExp.FirstVertex_s(e)), vertices.index(TopExp.LastVertex_s(e)))
+                 for e in edges.items)
     return Topology(name=name, faces=tuple(faces), edges=tuple(edges.items),
                     degenerate=tuple(bool(BRep_Tool.Degenerated_s(e)) for e in edges.items),
-                    wires=tuple(wires), edge_faces=tuple(tuple(f) for f in edge_faces))
+                    wires=tuple(wires), edge_faces=tuple(tuple(f) for f in edge_faces), edge_vertices=ends)
 
 
 def _check_extent(shape, name: str) -> None:

@@ -12,13 +12,16 @@ standard style, 10 % wider for readers with wider fonts.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
 import shapely
 
-__all__ = ["Label", "LabelPlacer", "text_box"]
+from ..units import Unit
+from .piece import Piece, SeamSide
+
+__all__ = ["Label", "LabelPlacer", "piece_labels", "readable_angle", "seam_text", "text_box"]
 
 SCALES = (1.0, 0.8, 0.64, 0.5, 0.4, 0.33)
 """The sizes a label is tried at, as fractions of the size it asks for."""
@@ -49,12 +52,16 @@ def text_box(text: str, at, height: float, angle: float, *, widen: float = 1.1) 
 
 @dataclass(frozen=True)
 class Label:
-    """A placed label: its text, centre (2,) mm, cap height mm and angle (degrees)."""
+    """A placed label: its text, centre (2,) mm, cap height mm and angle (degrees), and what it says:
+    ``"title"`` (the piece's name and what it is), ``"seam"`` (a seam side's lengths) or ``"bend"``."""
 
     text: str
     at: np.ndarray
     height: float
     angle: float
+    kind: str = "title"
+    of: int = -1
+    """A seam label's index in :attr:`Piece.seams`, a bend label's in :attr:`Piece.bends` (-1 for the title)."""
 
 
 class LabelPlacer:
@@ -132,4 +139,66 @@ def along(points: np.ndarray, inward_offset: float, *, fractions=(0.5, 0.4, 0.6,
         p = points[j] + u * (points[j + 1] - points[j])
         tangent = (points[j + 1] - points[j]) / max(seg[j], 1e-300)
         out.append((p + inward_offset * np.array([-tangent[1], tangent[0]]), tangent))
+    return out
+
+
+def readable_angle(direction) -> float:
+    """The angle (degrees, in (-90, 90]) of a text along ``direction`` (2,), so that it reads left to right."""
+    angle = float(np.degrees(np.arctan2(direction[1], direction[0])))
+    if angle > 90:
+        angle -= 180
+    elif angle <= -90:
+        angle += 180
+    return angle
+
+
+def seam_text(side: SeamSide, unit: Unit = Unit.MM) -> str:
+    """The annotation written next to a seam: id, 3D length and this side's flat length, in the drawing's unit.
+
+    Two decimals in mm, four in the larger units (0.01 mm or finer either way).
+    """
+    digits = 2 if unit is Unit.MM else 4
+    return (f"S{side.seam} 3D {side.length_3d / unit.mm:.{digits}f} FLAT {side.length_flat / unit.mm:.{digits}f} "
+            f"{unit.label}")
+
+
+def piece_labels(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> list:
+    """Every label of a piece, each placed clear of the others inside the finished piece.
+
+    Parameters
+    ----------
+    piece : Piece
+    unit : patterns.Unit
+        The drawing's unit (the seam labels say it).
+    block : list of (str, float, float), optional
+        The title block, as :meth:`LabelPlacer.place_block` takes it; default the piece's name
+        (1.2 text heights) and the first line of its title (0.7).
+
+    Returns
+    -------
+    list of Label
+        The title block (kind ``"title"``), then one label per seam side (``"seam"``, 0.6 text heights,
+        along the seam and 1.6 label heights inside it, its middle first), then one per bend line
+        (``"bend"``, half a text height, centred on the line).
+    """
+    placer = LabelPlacer(piece.finished)
+    th = piece.text_height
+    if block is None:
+        block = [(piece.name, 0.8, 1.2)] + [(line, -0.9, 0.7) for line in piece.title[:1]]
+    out = list(placer.place_block(block, placer.inside_places(piece.label_at, th), th))
+    for k, side in enumerate(piece.seams):
+        text = seam_text(side, unit)
+        for place, tangent in along(side.points, 1.6 * 0.6 * th):
+            label = placer.place(text, [place], 0.6 * th, readable_angle(tangent))
+            if label is not None:
+                out.append(replace(label, kind="seam", of=k))
+                break
+    for k, bend in enumerate(piece.bends):
+        a, b = bend.line
+        length = float(np.linalg.norm(b - a))
+        direction = (b - a) / max(length, 1e-12)
+        places = [b - direction * f * length for f in (0.1, 0.3, 0.5, 0.7, 0.9)]
+        label = placer.place(bend.label, places, 0.5 * th, readable_angle(direction))
+        if label is not None:
+            out.append(replace(label, kind="bend", of=k))
     return out

@@ -1,0 +1,133 @@
+"""A batch's worker side: one part's bytes in, its row and its outputs' bytes out.
+
+:func:`process_part` runs the whole pipeline (:func:`patterns.jobs.flatten_part`,
+or :func:`patterns.jobs.unfold_part` for a bent sheet-metal part) on a part
+given as bytes, in a private temporary folder, and never raises for the
+part's fault.  :func:`worker_main` is a local worker process's loop.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from ..errors import PatternsError
+from ..findings import Code
+from ..jobs import PartResult, flatten_part, unfold_part
+from .plan import _SUFFIXES
+
+__all__ = ["OUT_OF_MEMORY", "process_part", "worker_main"]
+
+
+def process_part(name: str, data: bytes, records: dict, wanted: tuple) -> dict:
+    """Run the pipeline on one part given as bytes; return its row and outputs as bytes.  Never raises
+    for the part's fault (a bad file, a limit, memory): that becomes the row's reason.
+
+    Parameters
+    ----------
+    name : str
+        The input's file name (its suffix says its type).
+    data : bytes
+        The file's content.
+    records : dict
+        The option records (``"load"``, ``"flatten"``, ``"check"``, ``"pieces"``, ``"write"``, ``"nest"``;
+        ``"unfold"`` instead of ``"load"`` and ``"flatten"`` to unfold a bent sheet-metal part).
+    wanted : tuple of str
+        Output kinds: ``"pattern"`` (DXF), ``"report"``, ``"heat_map"``, ``"preview"``.
+
+    Returns
+    -------
+    dict
+        The :class:`Row` fields (``file``, ``status``, ...) and ``files``:
+        ``{kind: bytes}`` of every output.
+    """
+    start = time.perf_counter()
+    row = {"file": name, "status": "failed", "reason": "", "files": {}}
+    try:
+        with tempfile.TemporaryDirectory(prefix="patterns-part-") as tmp:
+            source = Path(tmp) / name
+            source.write_bytes(data)
+            outputs = {kind: Path(tmp) / _SUFFIXES[kind].format("out") for kind in wanted}
+            run = unfold_part if "unfold" in records else flatten_part
+            try:
+                part = run(source, records, outputs=outputs, stage=lambda path, what: path)
+            except PatternsError as exc:
+                row["reason"] = str(exc).replace(tmp + os.sep, "")
+                return row
+            report = part.report
+            row["files"] = {kind: path.read_bytes() for kind, path in part.written.items()}
+            row.update(status="ok" if report.ok else "check failed",
+                       reason="" if report.ok else report.findings[0].message, **_numbers(part))
+    except MemoryError:
+        row.update(status="failed", reason="out of memory (over the worker's memory budget)", files={})
+    except Exception as exc:  # noqa: BLE001 - a defect of ours must not sink the batch: the row says what
+        row.update(status="failed", reason=f"internal error: {type(exc).__name__}: {exc}", files={})
+    finally:
+        row["seconds"] = time.perf_counter() - start
+    return row
+
+
+def _numbers(part: PartResult) -> dict:
+    """The row's panels, seams and strains: a pattern's, or a blank's (one piece, no seam, exact unless a face
+    had to be meshed)."""
+    report = part.report
+    if part.model is None:
+        meshed = any(f.code is Code.MESHED_FACE for f in report.findings)
+        return {"panels": 1, "seams": 0, "strain_rms": None if meshed else 0.0,
+                "strain_max": None if meshed else 0.0}
+    return {"panels": len(part.model.panels), "seams": len(part.model.seams),
+            "strain_rms": max(p.strain_rms for p in report.panels), "strain_max": max(p.strain_max for p in report.panels)}
+
+
+def worker_main(conn, budget: int | None, one_thread: bool) -> None:  # pragma: no cover - in a child process
+    """A local worker: dies with its parent, ignores Ctrl-C (the parent stops it), stays in its memory budget,
+    and never prints: what goes wrong goes back to the parent, or the worker just ends."""
+    try:
+        _die_with_parent()
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        if budget:
+            import resource
+
+            resource.setrlimit(resource.RLIMIT_AS, (budget, budget))
+        if one_thread:
+            from threadpoolctl import threadpool_limits
+
+            threadpool_limits(1)
+        try:  # the heavy imports now, not inside the first file's time
+            import build123d  # noqa: F401
+            import ezdxf  # noqa: F401
+            import matplotlib.figure  # noqa: F401
+            import trimesh  # noqa: F401
+
+            from .. import jobs  # noqa: F401
+        except BaseException as exc:  # noqa: BLE001 - said to the parent, which stops the batch
+            conn.send(("cannot start", f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"))
+            return
+        conn.send("ready")  # a file's time starts when it is handed over, not while the worker starts
+        while True:
+            task = conn.recv()
+            if task is None:
+                return
+            conn.send(process_part(*task))
+    except MemoryError:  # even the file's bytes do not fit the budget: the parent says so
+        os._exit(OUT_OF_MEMORY)
+    except BaseException:  # noqa: BLE001 - the parent sees the pipe close: the file is retried or lost
+        os._exit(1)
+
+
+OUT_OF_MEMORY = 3
+"""A local worker's exit code when a file's bytes alone exceed its memory budget."""
+
+
+def _die_with_parent() -> None:
+    """Linux: SIGKILL this process when its parent dies (a killed batch leaves no worker behind)."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG

@@ -1,0 +1,140 @@
+"""One layer and colour convention for every DXF a machine cuts from, and the layer maps shops ask for.
+
+Every line of a piece has a *role*: ``cut`` (the outline), ``hole`` (a
+cut-out), ``sew``, ``notch``, ``grain``, ``drill``, ``bend_up`` and
+``bend_down`` (a blank's bends, by the way the flange turns), ``bend`` (a
+ruling of a rolled panel, bumped either way), ``label``, ``strain`` and
+``stock``.  A :class:`LayerMap` gives each role a layer (name, AutoCAD colour
+index, linetype).  Flattened patterns and unfolded blanks use the same map;
+the presets:
+
+* ``patterns`` (default): ``CUT`` 1 red, ``SEW`` 5, ``NOTCH`` 6, ``GRAIN`` 3,
+  ``BEND`` 2 dashed (every bend), ``DRILL`` 4, ``LABEL`` 7, ``STRAIN`` 8,
+  ``STOCK`` 9;
+* ``updown``: as ``patterns``, with ``BEND_UP`` and ``BEND_DOWN`` by direction
+  (FreeCAD SheetMetal issue 551);
+* ``solidworks``: outline and holes on ``0`` (colour 7), as SolidWorks writes
+  its flat patterns, bend lines on ``BEND`` in SolidWorks' ``CENTERX2``
+  linetype;
+* ``inventor``: Autodesk Inventor's flat-pattern layers (``IV_OUTER_PROFILE``,
+  ``IV_INTERIOR_PROFILES``, ``IV_BEND``, ``IV_BEND_DOWN``, ``IV_ROLL``).
+
+Bend lines are dashed in every preset.  A map is a preset, then ``role=LAYER``
+overrides (``"updown,bend_up=UP"``); ``role=`` leaves a role out of the file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from ..errors import InputError
+
+__all__ = ["LINETYPES", "PRESETS", "ROLES", "Layer", "LayerMap", "layer_map"]
+
+ROLES = ("cut", "hole", "sew", "notch", "grain", "drill", "bend", "bend_up", "bend_down", "label", "strain", "stock")
+"""What a line on a piece is, in the order layers are declared."""
+
+LINETYPES = {
+    "DASHED": ([5.0, 3.0, -2.0], "Dashed __ __ __ __"),
+    "CENTERX2": ([20.32, 12.7, -2.54, 2.54, -2.54], "Center (2x) ________  __  ________  __"),  # as SolidWorks writes it
+}
+"""Linetypes the presets use: ``{name: (DXF pattern: total length, then dashes (+) and gaps (-), mm; description)}``."""
+
+
+@dataclass(frozen=True)
+class Layer:
+    """A DXF layer: its name, AutoCAD colour index and linetype."""
+
+    name: str
+    color: int = 7
+    linetype: str = "CONTINUOUS"
+
+
+_BASE = {"cut": Layer("CUT", 1), "hole": Layer("CUT", 1), "sew": Layer("SEW", 5), "notch": Layer("NOTCH", 6),
+         "grain": Layer("GRAIN", 3), "drill": Layer("DRILL", 4), "bend": Layer("BEND", 2, "DASHED"),
+         "bend_up": Layer("BEND", 2, "DASHED"), "bend_down": Layer("BEND", 2, "DASHED"),
+         "label": Layer("LABEL", 7), "strain": Layer("STRAIN", 8), "stock": Layer("STOCK", 9)}
+
+PRESETS = {
+    "patterns": _BASE,
+    "updown": {**_BASE, "bend_up": Layer("BEND_UP", 2, "DASHED"), "bend_down": Layer("BEND_DOWN", 30, "DASHED")},
+    "solidworks": {**_BASE, "cut": Layer("0", 7), "hole": Layer("0", 7), "bend": Layer("BEND", 7, "CENTERX2"),
+                   "bend_up": Layer("BEND", 7, "CENTERX2"), "bend_down": Layer("BEND", 7, "CENTERX2")},
+    "inventor": {**_BASE, "cut": Layer("IV_OUTER_PROFILE", 7), "hole": Layer("IV_INTERIOR_PROFILES", 7),
+                 "bend": Layer("IV_ROLL", 2, "DASHED"), "bend_up": Layer("IV_BEND", 2, "DASHED"),
+                 "bend_down": Layer("IV_BEND_DOWN", 30, "DASHED")},
+}
+"""The layer maps by name (``--layer-map NAME``)."""
+
+
+@dataclass(frozen=True)
+class LayerMap:
+    """Each role's layer; a role mapped to None is left out of the file.
+
+    Attributes
+    ----------
+    name : str
+        What it was made from (``"updown"``, ``"patterns,bend=RULING"``).
+    layers : tuple of (str, Layer or None)
+        ``(role, layer)`` for every role of :data:`ROLES`, in that order.
+    """
+
+    name: str
+    layers: tuple
+
+    def __getitem__(self, role: str) -> Layer | None:
+        return dict(self.layers)[role]
+
+    def declared(self) -> list:
+        """The distinct layers used, in the order of :data:`ROLES` (a layer two roles share once)."""
+        seen = {}
+        for _, layer in self.layers:
+            if layer is not None and layer.name not in seen:
+                seen[layer.name] = layer
+        return list(seen.values())
+
+    def __str__(self) -> str:
+        return self.name
+
+
+def _item(role, value, option) -> Layer | None:
+    if role not in ROLES:
+        raise InputError(f"{option}: unknown role {role!r}; the roles are {', '.join(ROLES)}")
+    if value is None or value == "":
+        return None
+    if isinstance(value, Layer):
+        return value
+    if isinstance(value, str):
+        return Layer(value, _BASE[role].color, _BASE[role].linetype)
+    raise InputError(f"{option}[{role!r}] must be a layer name or a patterns.export.layers.Layer, got "
+                     f"{type(value).__name__}")
+
+
+def layer_map(value, option: str = "layer_map") -> LayerMap:
+    """A :class:`LayerMap` from a preset name, ``"preset,role=LAYER,..."``, a mapping ``{role: layer name or
+    Layer or None}`` (over the ``patterns`` preset), or a LayerMap; InputError naming what is wrong."""
+    if isinstance(value, LayerMap):
+        return value
+    if isinstance(value, Mapping):
+        layers = dict(PRESETS["patterns"])
+        for role, layer in value.items():
+            layers[role] = _item(role, layer, option)
+        name = "patterns," + ",".join(f"{k}={getattr(v, 'name', v) or ''}" for k, v in value.items())
+        return LayerMap(name, tuple((r, layers[r]) for r in ROLES))
+    if not isinstance(value, str):
+        raise InputError(f"{option} must be a preset ({', '.join(PRESETS)}), 'preset,role=LAYER,...' or a mapping, "
+                         f"got {type(value).__name__}")
+    parts = [p.strip() for p in value.split(",") if p.strip()]
+    preset = "patterns"
+    if parts and "=" not in parts[0]:
+        preset = parts.pop(0)
+        if preset not in PRESETS:
+            raise InputError(f"{option}: unknown preset {preset!r}; the presets are {', '.join(PRESETS)}")
+    layers = dict(PRESETS[preset])
+    for part in parts:
+        role, sep, name = part.partition("=")
+        if not sep:
+            raise InputError(f"{option}: expected role=LAYER after the preset, got {part!r}")
+        layers[role.strip()] = _item(role.strip(), name.strip(), option)
+    return LayerMap(value, tuple((r, layers[r]) for r in ROLES))

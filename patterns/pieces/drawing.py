@@ -1,0 +1,134 @@
+"""A drawing: the pieces one file holds, in the one frame every writer of that file uses.
+
+:func:`drawing_of` lays out pieces that are not nested in rows of their
+bounding boxes (moved only, never turned or scaled) and puts the whole
+drawing in the first quadrant, :data:`MARGIN` from each axis, where a
+cutter's work area and a page start.  A nest (:func:`patterns.layout`) is
+moved the same way, roll or sheets and all.  Writers never move anything: the
+DXF, the SVG and the JSON report of one drawing have every coordinate in
+common.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..curves import Motion
+from ..findings import Finding
+from ..pattern import Pattern
+from .build import pieces_of
+from .options import PieceOptions
+
+__all__ = ["MARGIN", "Drawing", "arrange", "drawing_of", "place_nest", "row_offsets"]
+
+MARGIN = 5.0
+"""Every drawing starts this far (mm) from the X and Y axes, in the first quadrant."""
+
+
+@dataclass(frozen=True, eq=False)
+class Drawing:
+    """What one file holds (mm, the file's own frame).
+
+    Attributes
+    ----------
+    name : str
+        The part's or the nest's name.
+    pieces : tuple of Piece
+    stock : tuple of (x0, y0, x1, y1)
+        A nest's roll (its used length) or each of its sheets, mm; empty when not nested.
+    note : str
+        A nest's summary ("a 1500 mm roll: 3592.0 mm used, efficiency 74.2 %"), drawn beside the stock.
+    report : dict or None
+        The check report (``patterns.Report.to_dict``) of what the pieces were made from, in this frame:
+        the JSON profile writes it with the pieces.
+    """
+
+    name: str
+    pieces: tuple
+    stock: tuple = ()
+    note: str = ""
+    report: Mapping | None = field(default=None)
+
+    @property
+    def bounds(self) -> tuple:
+        """``(x0, y0, x1, y1)`` of every cut outline and the stock, mm."""
+        boxes = [p.bounds for p in self.pieces] + [tuple(s) for s in self.stock]
+        b = np.array(boxes, dtype=np.float64).reshape(-1, 4)
+        return (float(b[:, 0].min()), float(b[:, 1].min()), float(b[:, 2].max()), float(b[:, 3].max()))
+
+
+def row_offsets(boxes, *, gap: float | None = None) -> np.ndarray:
+    """Where to move each box so that they lie in rows: ``(k, 2)`` mm translations.
+
+    ``boxes`` ``(k, 4)``: ``(x0, y0, x1, y1)`` each, mm.  Rows run left to right, downwards, about
+    1.6 times as wide as the boxes' total area's square root; ``gap`` (default 8 % of the largest box)
+    between boxes and rows.
+    """
+    boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
+    sizes = boxes[:, 2:] - boxes[:, :2]
+    if gap is None:
+        gap = 0.08 * float(np.max(sizes))
+    width = max(float(np.sqrt((sizes[:, 0] + gap) @ (sizes[:, 1] + gap)) * 1.6), float(sizes[:, 0].max()))
+    offsets = np.zeros((len(boxes), 2))
+    x = y = row = 0.0
+    for i, (w, h) in enumerate(sizes):
+        if x > 0 and x + w > width:
+            x, y, row = 0.0, y - row - gap, 0.0
+        offsets[i] = (x - boxes[i, 0], y - boxes[i, 3])
+        x += w + gap
+        row = max(row, h)
+    return offsets
+
+
+def _to_margin(pieces, stock, margin: float) -> tuple:
+    """Pieces and stock moved together so that their extents start ``margin`` from both axes."""
+    d = Drawing("", tuple(pieces), tuple(stock))
+    x0, y0, _, _ = d.bounds
+    shift = Motion(0.0, margin - x0, margin - y0)
+    moved = tuple(p.moved(shift) for p in pieces)
+    rects = tuple((x0_ + shift.dx, y0_ + shift.dy, x1_ + shift.dx, y1_ + shift.dy) for x0_, y0_, x1_, y1_ in stock)
+    return moved, rects
+
+
+def arrange(pieces, *, gap: float | None = None, margin: float = MARGIN, rows: bool = True) -> tuple:
+    """Pieces laid in rows of their bounding boxes (``rows``; else where they lie), moved only, the drawing
+    ``margin`` mm from both axes."""
+    pieces = tuple(pieces)
+    if not rows:
+        return _to_margin(pieces, (), margin)[0]
+    offsets = row_offsets([p.bounds for p in pieces], gap=gap)
+    moved = [p.moved(Motion(0.0, float(dx), float(dy))) for p, (dx, dy) in zip(pieces, offsets)]
+    return _to_margin(moved, (), margin)[0]
+
+
+def place_nest(pieces, stock, *, margin: float = MARGIN) -> tuple:
+    """``(pieces, stock)`` of a nest moved together into the drawing's frame."""
+    return _to_margin(tuple(pieces), tuple(stock), margin)
+
+
+def drawing_of(source, options: PieceOptions | None = None, *, findings: tuple[Finding, ...] = (),
+               **keywords) -> Drawing:
+    """The drawing of a pattern, a blank, pieces or a list of them: their pieces laid in rows (a pattern
+    already laid out, :meth:`patterns.Pattern.placed`, keeps its layout).
+
+    Parameters
+    ----------
+    source : patterns.Pattern, patterns.Blank, Piece, Drawing, or a sequence of them
+        A :class:`Drawing` is returned as it is.
+    options : PieceOptions, optional
+        Keywords (any :class:`PieceOptions` field) go over it; ``gap`` is the space between pieces.
+    findings : tuple of patterns.Finding
+        A pattern's check findings, for its pieces.
+    """
+    if isinstance(source, Drawing):
+        return source
+    opts = PieceOptions.of(options, keywords)
+    pieces = pieces_of(source, opts, findings=findings)
+    items = list(source) if isinstance(source, (list, tuple)) else [source]
+    name = " + ".join(dict.fromkeys(str(getattr(item, "name", "")) for item in items)) or "pieces"
+    laid_out = isinstance(source, Pattern) and source.laid_out
+    return Drawing(name, arrange(pieces, gap=opts.gap, rows=not laid_out))
+

@@ -1,0 +1,117 @@
+"""Sheet metal: unfold a bent part into one flat blank, as SolidWorks and FreeCAD's SheetMetal do.
+
+An unfold is a pipeline of stages over frozen records, like the CAD mesher:
+
+1. :func:`~patterns.sheetmetal.faces.recognise` -- every face with the
+   surface the mesher's recogniser finds (plane, cylinder, cone, or none);
+2. :func:`~patterns.sheetmetal.sheet.find_sheet` -- the fixed face, the
+   thickness and the skin (a :class:`~patterns.sheetmetal.sheet.Sheet`);
+3. :mod:`~patterns.sheetmetal.bends` -- each bend face's curvature, the bends
+   (:class:`~patterns.sheetmetal.bends.BendGroup`, developed to their neutral
+   width: ``angle (r + K t)`` or a bend table's), and every skin face's exact
+   map to the flat (:class:`~patterns.sheetmetal.bends.FaceMap`); a face that
+   is none of these is meshed and flattened
+   (:mod:`~patterns.sheetmetal.meshed`), with its strain reported;
+4. :func:`~patterns.sheetmetal.join.place_faces` -- the faces joined by rigid
+   motions from the fixed face outwards, every shared edge checked to meet;
+5. :mod:`~patterns.sheetmetal.contour` -- the cut contour as exact lines and
+   arcs, chained into loops, the bend lines, and flanges that collide.
+
+The result is a :class:`patterns.Blank`, whose findings are the same
+:class:`patterns.Finding` records :func:`patterns.check` reports.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..blank import Bend, Blank
+from ..errors import InputError
+from ..findings import Code, Finding, Severity
+from ..reading import read_cad
+from ..tessellate.topology import read_topology
+from .bends import curvatures, face_maps, group_bends
+from .contour import bend_line, cut_loops, overlaps
+from .faces import recognise, uv_mid
+from .join import flat, place_faces
+from .meshed import mesh_face
+from .sheet import check_volume, find_sheet
+from .table import BendTable, UnfoldOptions, read_bend_table
+
+__all__ = ["BendTable", "UnfoldOptions", "read_bend_table", "unfold"]
+
+
+def _shape(source, name):
+    from OCP.TopoDS import TopoDS_Shape
+
+    if isinstance(source, (str, Path)):
+        return read_cad(source), name or Path(source).stem
+    wrapped = getattr(source, "wrapped", source)  # a build123d shape wraps its OCP one
+    if not isinstance(wrapped, TopoDS_Shape):
+        raise InputError(f"unfold takes a STEP/BREP/IGES path or a build123d/OCP shape, got {type(source).__name__}")
+    return wrapped, name or "part"
+
+
+def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | None = None, **keywords) -> Blank:
+    """Unfold a bent sheet-metal part into its flat blank.
+
+    Parameters
+    ----------
+    shape_or_path : str, Path, build123d shape or OCP ``TopoDS_Shape``
+        The folded solid (STEP, BREP or IGES file, mm).
+    options : UnfoldOptions, optional
+        The options as a record; keywords (``k_factor``, default 0.5;
+        ``bend_table``, a CSV path or :class:`BendTable`; ``fixed_face``) go over it.
+    name : str, optional
+        For messages and the report (default: the file's stem).
+
+    Returns
+    -------
+    patterns.Blank
+        The outline and holes (exact lines and arcs), the bend lines, the
+        thickness read from the model, and findings (flanges that overlap once
+        unfolded, a bend with no flat face on one side, a meshed face).  The
+        fixed face keeps its own plane coordinates.
+
+    Raises
+    ------
+    InputError
+        Not a sheet of constant thickness, a closed tube, a bad option, a bend the table does not cover.
+    CadError
+        The file cannot be read.
+    """
+    shape, name = _shape(shape_or_path, name)
+    opts = UnfoldOptions.of(options, keywords, name=name)
+    topology = read_topology(shape, name=name)
+    faces = recognise(topology)
+    sheet = find_sheet(topology, faces, opts.fixed_face, name)
+    curvature = curvatures(faces, sheet, name)
+    meshed = {i: mesh_face(faces[i], sheet.thickness, opts.k_factor, name)  # the K-factor even with a bend table
+              for i in sorted(sheet.skin) if faces[i].kind == "other"}
+    check_volume(shape, sheet, faces, {i: (c.bend_radius, c.inside_radius) for i, c in curvature.items()}, meshed,
+                 name)
+    bends = group_bends(faces, sheet, curvature, opts, name)
+    maps = face_maps(faces, sheet, curvature, bends, meshed, opts.k_factor)
+    motions, gaps = place_faces(topology, maps, sheet, name)
+    loops = cut_loops(topology, maps, motions, sheet.skin, name)
+    outline = max(loops, key=lambda lp: lp.area)
+    holes = tuple(lp for lp in loops if lp is not outline)
+    k_factor = None if opts.bend_table is not None else opts.k_factor
+    drawn = tuple(Bend(line=bend_line(maps, motions, b), angle=b.angle, inside_radius=b.inside_radius,
+                       direction=b.direction, allowance=b.allowance, faces=b.faces, k_factor=k_factor)
+                  for b in bends)
+    findings = list(overlaps(topology, maps, motions, sheet.skin, gaps, name))
+    findings += [Finding(Code.BEND_WITHOUT_FLANGE, Severity.NOTE, (name,), bend.line.mean(axis=0)[None, :], (), None,
+                         f"{name}: bend at faces {', '.join(map(str, bend.faces))} has no flat face on one side")
+                 for bend, group in zip(drawn, bends) if not group.flanged]
+    for i, m in sorted(meshed.items()):
+        d = m.flattening.distortion
+        findings.append(Finding(
+            Code.MESHED_FACE, Severity.NOTE, (name,), flat(maps, motions, i, [uv_mid(faces[i].face)]), (), None,
+            f"{name}: face {i} is not developable as a plane, cylinder or cone: meshed "
+            f"({len(m.triangles)} triangles) and flattened, strain up to {d.strain_max:.3%} (rms "
+            f"{d.strain_rms:.3%}); its edges land within {gaps[i]:.3f} mm of the faces beside it"))
+    order = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
+    findings.sort(key=lambda f: order[f.severity])
+    return Blank(name=name, outline=outline, holes=holes, bends=drawn, thickness=sheet.thickness,
+                 k_factor=k_factor, fixed_face=sheet.fixed, findings=tuple(findings))

@@ -1,0 +1,173 @@
+"""Stage 2 of an unfold: the sheet -- its thickness, and the skin that becomes the blank.
+
+A bent sheet-metal part is a solid of constant thickness ``t``: two skins
+(the inside and the outside of every bend) joined by narrow rim faces.  The
+thickness is the distance from the fixed planar face to the nearest opposite,
+parallel face behind it; the skin is every face reached from the fixed face
+across tangent edges (the rims meet it at a corner).  A part whose skin is
+much less than half its surface is not a sheet (a block, a thick plate, the
+end of a tube); one whose volume is not that of a sheet of this thickness over
+its skin (within 1 %) is refused too, by :func:`check_volume`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+from ..errors import InputError
+from ..tessellate.topology import Topology
+from .faces import normal, point, uv_mid
+
+__all__ = ["Sheet", "check_volume", "find_sheet"]
+
+TANGENT = 1e-4
+"""Two faces are tangent along an edge when their normals there differ by less than this (radians, about)."""
+SIDE = 0.4
+"""One skin of a sheet is nearly half its surface (0.46-0.50 on the parts measured); below this share, not a sheet."""
+
+
+@dataclass(frozen=True, eq=False)
+class Sheet:
+    """The sheet a part is bent from.
+
+    Attributes
+    ----------
+    thickness : float
+        mm.
+    fixed : int
+        The planar face that keeps its place.
+    skin : frozenset of int
+        The faces of the skin the blank is developed from (the fixed face's side).
+    neighbours : tuple
+        Per face, ``((other face, shared edge), ...)`` across its tangent edges.
+    """
+
+    thickness: float
+    fixed: int
+    skin: frozenset
+    neighbours: tuple
+
+
+def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: str) -> Sheet:
+    """The sheet: its fixed face (the largest planar face unless given), thickness and skin."""
+    largest = max(faces, key=lambda f: f.area)
+    if largest.kind == "cylinder" and any(owners == (largest.index, largest.index) for owners in topology.edge_faces):
+        raise InputError(f"{name}: a closed tube (face {largest.index} goes all the way round, with no seam): "
+                         f"cut it along a line of its axis first")
+    planes = [f for f in faces if f.kind == "plane"]
+    if not planes:
+        raise InputError(f"{name}: not a sheet-metal part: it has no planar face")
+    if fixed_face is None:
+        fixed = max(planes, key=lambda f: f.area).index
+    elif fixed_face >= len(faces) or faces[fixed_face].kind != "plane":
+        raise InputError(f"{name}: fixed_face {fixed_face} is not a planar face of the part "
+                         f"(it has faces 0..{len(faces) - 1})")
+    else:
+        fixed = fixed_face
+    thickness = _thickness(faces, fixed, name)
+    skin, neighbours = _skin(topology, faces, fixed, name)
+    share = sum(faces[i].area for i in skin) / sum(f.area for f in faces)
+    if share < SIDE:
+        raise InputError(f"{name}: not a sheet: face {fixed} and the faces joined to it smoothly are {share:.0%} of "
+                         f"the part's surface, one side of a sheet nearly half (a block, a thick plate, the end "
+                         f"of a tube)")
+    return Sheet(thickness, fixed, frozenset(skin), neighbours)
+
+
+def _thickness(faces, fixed, name) -> float:
+    """Distance from the fixed planar face to the nearest opposite parallel face behind it, mm."""
+    f = faces[fixed]
+    u, v = uv_mid(f.face)
+    n, p = normal(f, u, v), point(f, u, v)
+    best = None
+    for g in faces:
+        if g.kind != "plane" or g.index == fixed:
+            continue
+        gu, gv = uv_mid(g.face)
+        m, q = normal(g, gu, gv), point(g, gu, gv)
+        depth = -(q - p) @ n
+        if m @ n < -1 + 1e-8 and depth > 1e-6 and (best is None or depth < best):
+            best = depth
+    if best is None:
+        raise InputError(f"{name}: not a sheet: face {fixed} has no parallel face behind it (no constant thickness)")
+    return float(best)
+
+
+def _tangent_edges(topology: Topology, faces) -> dict:
+    """``{edge: (face a, face b)}`` of every edge along which two faces meet tangentially, ``{edge: None}`` for
+    a closed face's own seam line."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
+
+    out = {}
+    for e, owners in enumerate(topology.edge_faces):
+        if topology.degenerate[e]:
+            continue
+        if len(owners) == 2 and owners[0] == owners[1]:
+            out[e] = None
+            continue
+        if len(set(owners)) != 2:
+            continue
+        edge = topology.edges[e]
+        c = BRepAdaptor_Curve(edge)
+        tm = 0.5 * (c.FirstParameter() + c.LastParameter())
+        normals = []
+        for k in owners:
+            p = BRepAdaptor_Curve2d(edge, faces[k].face).Value(tm)
+            normals.append(normal(faces[k], p.X(), p.Y()))
+        if normals[0] @ normals[1] > 1 - TANGENT:
+            out[e] = tuple(owners)
+    return out
+
+
+def _skin(topology: Topology, faces, fixed, name):
+    """The faces reached from ``fixed`` across tangent edges, and every face's tangent neighbours."""
+    tangent = _tangent_edges(topology, faces)
+    neighbours = [[] for _ in faces]
+    for e, pair in tangent.items():
+        if pair is not None:
+            a, b = pair
+            neighbours[a].append((b, e))
+            neighbours[b].append((a, e))
+    skin, stack = {fixed}, [fixed]
+    while stack:
+        i = stack.pop()
+        for j, _ in neighbours[i]:
+            if j not in skin:
+                skin.add(j)
+                stack.append(j)
+    for e, pair in tangent.items():
+        if pair is None and topology.edge_faces[e][0] in skin:
+            raise InputError(f"{name}: the sheet closes on itself around face {topology.edge_faces[e][0]} "
+                             f"(a tube with no seam): cut it along a line first")
+    return skin, tuple(tuple(n) for n in neighbours)
+
+
+def check_volume(shape, sheet: Sheet, faces, curvature: dict, meshed: dict, name: str) -> None:
+    """InputError unless the solid holds the volume a sheet of this thickness over the skin holds (1 %).
+
+    ``curvature`` gives each bend face's ``(bend radius, inside radius)``, ``meshed`` each meshed face's
+    :class:`~patterns.sheetmetal.meshed.MeshedFace` (its own volume).
+    """
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    volume = abs(props.Mass())
+    t = sheet.thickness
+    expected = 0.0
+    for i in sheet.skin:
+        f = faces[i]
+        if f.kind == "other":
+            expected += meshed[i].volume
+        elif f.kind == "plane":
+            expected += f.area * t
+        else:
+            bend_radius, r_in = curvature[i]
+            expected += f.area / bend_radius * ((r_in + t) ** 2 - r_in ** 2) / 2
+    if abs(volume - expected) > 0.01 * volume:
+        raise InputError(f"{name}: not a sheet of constant thickness: the solid holds {volume:.0f} mm³, a "
+                         f"{t:g} mm sheet over its skin {expected:.0f} mm³ (a machined block or a "
+                         f"part of several thicknesses)")
+    return None
