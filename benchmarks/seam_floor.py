@@ -30,6 +30,7 @@ if str(REPO) not in sys.path:
 
 import patterns
 from patterns.flattening.embed import lscm, tutte_embedding
+from patterns.flattening.moves import best_scale
 from patterns.flattening.seams import SeamLengths, held_lengths
 from patterns.measure import strain_rms
 from patterns.mesh import unique_edges, validate_mesh
@@ -51,7 +52,7 @@ def starts(v, f, conn):
     out = {"free optimum": (free.uv, 0.0), "greedy": (patterns.flatten_mesh(v, f, method="isometric").uv, 0.0)}
     for name, make in (("lscm", lscm), ("tutte", tutte_embedding)):
         s = make(v, f, conn)
-        out[name] = (s * relax.best_scale(v, conn.edges, s), 0.1)
+        out[name] = (s * best_scale(v, conn.edges, s), 0.1)
     return free, out
 
 

@@ -32,7 +32,7 @@ for panel in report.panels:
     print(f"{panel.name}: {panel.area_flat:9.1f} mm2 flat, strain max {100 * panel.strain_max:.4f} %")
 print("ok" if report.ok else "\n".join(f.message for f in report.findings))
 
-pattern.to_dxf(out / "hood.dxf")                          # machine profile: CUT, NOTCH, LABEL, ...
-report.to_json(out / "hood.json")
-pattern.heat_map(out / "hood.png")
+patterns.write(pattern, out / "hood.dxf")                 # machine profile: CUT, NOTCH, LABEL, ...
+patterns.write(pattern, out / "hood.json", max_strain=0.001)  # the report, in the DXF's frame
+patterns.heat_map(pattern, out / "hood.png")
 print(f"wrote {out / 'hood.dxf'}, {out / 'hood.json'}, {out / 'hood.png'}")

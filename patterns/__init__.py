@@ -35,9 +35,9 @@ from .errors import (
     PatternsError,
 )
 from .export import WriteOptions, heat_map, preview_dxf, write
+from .findings import Code, Finding, Severity
 from .flattening import METHODS, Flattening, FlattenOptions, flatten, flatten_mesh
 from .flattening.energy import ENERGIES
-from .findings import Code, Finding, Severity
 from .flattening.seams import Ease, SeamLengths
 from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh

@@ -13,8 +13,8 @@ import numpy as np
 import shapely
 
 from .blank import Blank
-from .errors import InputError
 from .curves import Motion
+from .errors import InputError
 from .findings import Code, Finding, Severity
 from .measure import edge_strain, folded_faces, strain_stats
 from .model import Bookkeeping

@@ -114,8 +114,8 @@ class Blank:
 
     @property
     def area(self) -> float:
-        """Material area: the outline less the holes, mm²."""
-        return float(self.polygon.area)
+        """Material area: the outline less the holes, mm², exactly (arcs as arcs)."""
+        return self.outline.area - sum(h.area for h in self.holes)
 
     @property
     def perimeter(self) -> float:

@@ -2,8 +2,9 @@
 
 A shop that moves to `patterns` checks its blanks against the flat patterns it
 cut before.  :func:`read_flat_pattern` reads such a DXF -- its cut contours
-(LINE, ARC, CIRCLE, polylines, chained end to end) and its bend lines (the BEND
-layer, or a centre linetype as SolidWorks draws them) -- and
+(LINE, ARC, CIRCLE, polylines with bulges, chained end to end; arcs sampled
+exactly) and its bend lines (a BEND layer, or any line not drawn continuous:
+SolidWorks' centre lines, our dashed ones) -- and
 :func:`compare_blank` sets the two side by side: area, outer perimeter, holes,
 bend lines, and how far the outlines lie apart once the best rigid motion
 (mirror allowed: a blank may be drawn from either side) has put one on the
@@ -19,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import shapely
 
+from .curves import Arc, Loop
 from .errors import InputError
 
 __all__ = ["BlankComparison", "FlatPattern", "compare_blank", "read_flat_pattern"]
@@ -58,29 +60,52 @@ class FlatPattern:
         return float(shapely.LinearRing(self.outline).length)
 
 
-def _is_bend(entity) -> bool:
-    layer = entity.dxf.get("layer", "0").upper()
+def _is_bend(entity, doc) -> bool:
+    """A line that is not cut: on a bend layer (``BEND``, ``BEND_UP``, ``IV_BEND``, ...) or drawn in any linetype
+    but a continuous one (SolidWorks' centre lines, our dashed bend lines), its own or its layer's."""
+    layer = entity.dxf.get("layer", "0")
     linetype = entity.dxf.get("linetype", "BYLAYER").upper()
-    return "BEND" in layer or linetype.startswith(("CENTER", "DASHDOT"))
+    if linetype == "BYLAYER" and layer in doc.layers:
+        linetype = doc.layers.get(layer).dxf.get("linetype", "CONTINUOUS").upper()
+    return "BEND" in layer.upper() or linetype not in ("CONTINUOUS", "BYLAYER", "BYBLOCK")
+
+
+def _bulged(rows: np.ndarray, closed: bool, tolerance: float) -> np.ndarray:
+    """Points of a polyline given as ``(x, y, bulge)`` rows, its arcs sampled exactly within ``tolerance``."""
+    if closed:
+        return Loop.of_vertices(rows).points(tolerance)
+    pts = [rows[0, :2]]
+    for (x0, y0, bulge), (x1, y1, _) in zip(rows[:-1], rows[1:]):
+        if bulge:
+            pts.extend(Arc.from_bulge((x0, y0), (x1, y1), bulge).points(tolerance)[1:])
+        else:
+            pts.append(np.array([x1, y1]))
+    return np.array(pts)
 
 
 def _pieces(entity, tolerance: float):
-    """(k, 2) points of a contour entity (open piece), or ("closed", points) for a circle or closed polyline."""
+    """``(closed, (k, 2) points)`` of a contour entity, arcs sampled exactly within ``tolerance`` mm; None for
+    an entity that is no contour."""
     kind = entity.dxftype()
     if kind == "LINE":
         return False, np.array([entity.dxf.start, entity.dxf.end])[:, :2]
     if kind == "CIRCLE":
-        c, r = np.array(entity.dxf.center)[:2], entity.dxf.radius
-        n = max(16, int(np.ceil(np.pi / np.arccos(max(1 - tolerance / r, -1.0)))))
-        a = np.linspace(0, 2 * np.pi, n, endpoint=False)
-        return True, c + r * np.column_stack([np.cos(a), np.sin(a)])
-    if kind in ("ARC", "LWPOLYLINE", "POLYLINE", "SPLINE", "ELLIPSE"):
+        return True, Arc(np.array(entity.dxf.center)[:2], entity.dxf.radius, 0.0, 2 * np.pi).points(tolerance)[:-1]
+    if kind == "ARC":
+        a0, a1 = np.radians(entity.dxf.start_angle), np.radians(entity.dxf.end_angle)
+        sweep = (a1 - a0) % (2 * np.pi) or 2 * np.pi  # counter-clockwise from start to end
+        return False, Arc(np.array(entity.dxf.center)[:2], entity.dxf.radius, a0, sweep).points(tolerance)
+    if kind == "LWPOLYLINE":
+        rows = np.array([(x, y, b) for x, y, b in entity.get_points("xyb")], dtype=np.float64)
+        return bool(entity.closed), _bulged(rows, bool(entity.closed), tolerance)
+    if kind == "POLYLINE" and entity.is_2d_polyline:
+        rows = np.array([(*v.dxf.location[:2], v.dxf.get("bulge", 0.0)) for v in entity.vertices], dtype=np.float64)
+        return bool(entity.is_closed), _bulged(rows, bool(entity.is_closed), tolerance)
+    if kind in ("SPLINE", "ELLIPSE"):
         from ezdxf import path as ezpath
 
-        p = ezpath.make_path(entity)
-        pts = np.array([(v.x, v.y) for v in p.flattening(tolerance)])
-        closed = kind in ("LWPOLYLINE", "POLYLINE") and entity.is_closed
-        return closed, pts[:-1] if closed and np.allclose(pts[0], pts[-1]) else pts
+        pts = np.array([(v.x, v.y) for v in ezpath.make_path(entity).flattening(tolerance)])
+        return False, pts
     return None
 
 
@@ -106,7 +131,7 @@ def read_flat_pattern(path, *, tolerance: float = 0.001) -> FlatPattern:
         raise InputError(f"{path}: not a readable DXF file ({exc})") from None
     closed, open_, bends = [], [], []
     for entity in doc.modelspace():
-        if entity.dxftype() == "LINE" and _is_bend(entity):
+        if entity.dxftype() == "LINE" and _is_bend(entity, doc):
             bends.append(np.array([entity.dxf.start, entity.dxf.end])[:, :2])
             continue
         got = _pieces(entity, tolerance)

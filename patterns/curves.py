@@ -245,9 +245,19 @@ class Loop:
         return shapely.Polygon(self.points())
 
     @property
+    def signed_area(self) -> float:
+        """Enclosed area, mm², exactly (arcs as arcs): positive when the loop runs counter-clockwise."""
+        rows = self.vertices()
+        x, y = rows[:, 0], rows[:, 1]
+        polygon = 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+        arcs = [p for p in self.pieces if isinstance(p, Arc)]
+        return polygon + sum(0.5 * a.radius**2 * (a.sweep - np.sin(a.sweep)) for a in arcs)
+
+    @property
     def area(self) -> float:
-        """Enclosed area, mm² (positive)."""
-        return float(self.polygon.area)
+        """Enclosed area, mm² (positive), exactly: the polygon through the pieces' points and, for every
+        arc, the circular segment between it and its chord."""
+        return abs(self.signed_area)
 
     @property
     def length(self) -> float:
@@ -260,7 +270,7 @@ class Loop:
 
     @property
     def counter_clockwise(self) -> bool:
-        return bool(shapely.is_ccw(shapely.LinearRing(self.points(0.01))))
+        return self.signed_area > 0
 
     def moved(self, motion: Motion) -> Loop:
         """The loop moved by ``motion``; a mirrored motion also reverses it, so that it keeps its turning

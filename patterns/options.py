@@ -328,7 +328,7 @@ def from_arguments(record: type, args, *, name: str | None = None, **extra):
             continue
         negated = isinstance(f.default, bool) and f.default  # a flag that turns it off: --no-...
         dest = _dest(spec.flag or "--no-" + f.name.replace("_", "-")) if negated else _dest(flag_of(f.name, spec))
-        if not hasattr(args, dest):
+        if dest not in vars(args):
             continue  # a field the parser has no flag for (skipped by add_arguments): its default
         if negated:
             values[f.name] = not getattr(args, dest)

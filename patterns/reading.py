@@ -431,7 +431,7 @@ def load(source, options: LoadOptions | None = None, **keywords):
             raise InputError(f"{shown}: no such file")
         raise InputError(f"{shown}: unknown file type {suffix or '(none)'!r}; expected a CAD file "
                          f"({', '.join(CAD_SUFFIXES)}) or a mesh file ({', '.join(MESH_SUFFIXES)})")
-    if hasattr(source, "wrapped"):
+    if getattr(source, "wrapped", None) is not None:  # a build123d shape: mesh_shape checks what it wraps
         return mesh_shape(source, name=type(source).__name__, **meshing)
     raise InputError(f"cannot load a {type(source).__name__}: give a file path or a build123d shape")
 

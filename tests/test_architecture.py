@@ -112,3 +112,27 @@ def test_every_export_is_documented(name):
     obj = getattr(patterns, name)
     if callable(obj) and not isinstance(obj, type(patterns)):
         assert (obj.__doc__ or "").strip(), name
+
+
+MAX_MODULE_LINES = 650
+
+
+def test_no_module_is_too_long():
+    """Rooms are split along their jobs before they grow past 650 lines (the mesher, sheet metal, the writers)."""
+    long = {str(p.relative_to(PACKAGE)): n for p in _sources() if (n := len(p.read_text().splitlines())) > MAX_MODULE_LINES}
+    assert not long, long
+
+
+def test_no_type_is_erased_and_no_type_is_guessed():
+    """No field or parameter of the package is annotated ``object`` (name the type: the layers allow it), and no
+    ``hasattr`` stands in for a type test (``isinstance`` with the type, or ``Mapping`` for a mapping)."""
+    erased, guessed = [], []
+    for path in _sources():
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            annotation = getattr(node, "annotation", None) or getattr(node, "returns", None)
+            if isinstance(annotation, ast.Name) and annotation.id == "object":
+                erased.append(f"{path.name}:{node.lineno}")
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "hasattr":
+                guessed.append(f"{path.name}:{node.lineno}")
+    assert not erased and not guessed, (erased, guessed)

@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 import patterns
-
 from patterns.errors import InputError
 from patterns.flattening.develop import develop, neutral_offset, offset_points
 from patterns.measure import signed_areas

@@ -106,7 +106,7 @@ def test_code_block_runs(path, line, lang, code, workdirs):
         pytest.skip(f"a {lang} block")
 
 
-@pytest.mark.parametrize("command", ["flatten", "batch"])
+@pytest.mark.parametrize("command", ["flatten", "batch", "unfold"])
 def test_every_flag_is_in_the_cli_doc(command):
     """docs/cli.md names every flag the command has (the flags come from the option records)."""
     from patterns import cli

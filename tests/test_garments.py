@@ -11,8 +11,8 @@ import shapely.affinity
 import patterns
 from patterns import surfaces  # noqa: F401  (patterns.surfaces below)
 from patterns.errors import InputError
-from patterns.pieces.notches import notch_positions
 from patterns.measure import flat_direction
+from patterns.pieces.notches import notch_positions
 from patterns.samples import cup, duct_transition, hopper, hull_panel
 
 from .conftest import SAMPLES

@@ -7,7 +7,7 @@ import patterns
 from patterns import surfaces
 from patterns.errors import InputError
 from patterns.flattening.embed import lscm, tutte_embedding
-from patterns.flattening.relax import best_scale, flip_free_steps
+from patterns.flattening.moves import best_scale, flip_free_steps
 from patterns.mesh import validate_mesh
 from patterns.reading import read_mesh
 

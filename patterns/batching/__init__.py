@@ -36,8 +36,17 @@ from ..sheetmetal import UnfoldOptions
 from ..text import printable
 from .cluster import DaskRunner
 from .local import LocalRunner
-from .plan import (_SUFFIXES, STATUSES, BatchOptions, BatchResult, Row, check_output_folder, output_stems,
-                   plan_batch, wanted)
+from .plan import (
+    _SUFFIXES,
+    STATUSES,
+    BatchOptions,
+    BatchResult,
+    Row,
+    check_output_folder,
+    output_stems,
+    plan_batch,
+    wanted,
+)
 from .worker import process_part
 
 __all__ = ["STATUSES", "BatchOptions", "BatchResult", "Row", "batch", "check_output_folder", "output_stems",
@@ -142,7 +151,7 @@ def _options(options, records, keywords):
         if unknown:
             raise InputError(f"unknown option {unknown[0]!r} for batch{' --unfold' if opts.unfold else ''}")
     elif rest:
-        raise InputError(f"give the part's options as records or as keywords, not both ({sorted(rest)[0]!r})")
+        raise InputError(f"give the part's options as records or as keywords, not both ({min(rest)!r})")
     if opts.unfold and opts.heat_map:
         raise InputError("a blank is exact: it has no strain heat map (leave out heat_map with unfold)")
     return opts, records

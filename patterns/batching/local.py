@@ -9,6 +9,8 @@ lost; one over its memory budget fails alone.
 from __future__ import annotations
 
 import contextlib
+import multiprocessing.connection
+import multiprocessing.process
 import os
 import signal
 import time
@@ -39,8 +41,8 @@ def _environment(**values):
 
 @dataclass
 class _Worker:
-    process: object
-    conn: object
+    process: multiprocessing.process.BaseProcess
+    conn: multiprocessing.connection.Connection
     task: tuple | None = None  # (index, tries)
     started: float = 0.0
     ready: bool = False

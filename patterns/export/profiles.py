@@ -76,7 +76,7 @@ def write(source, path, options: WriteOptions | None = None, *, pieces: PieceOpt
     profile = profile_for(path, opts.profile)
     opts = replace(opts, profile=profile.name)
     if (check is not None or check_keywords) and profile.name != "json":
-        raise InputError(f"{path}: {sorted(check_keywords)[0] if check_keywords else 'check'} is a limit of the "
+        raise InputError(f"{path}: {min(check_keywords) if check_keywords else 'check'} is a limit of the "
                          f"JSON report, not of the {profile.name} profile")
     piece_opts = PieceOptions.of(pieces, piece_keywords, name=str(path))
     if profile.name == "astm" and piece_opts.arcs:

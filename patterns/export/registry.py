@@ -33,7 +33,8 @@ class Profile:
     help : str
         One line for ``--help`` and the docs.
     default : bool
-        The profile a file of this suffix gets when none is named.
+        The profile a file of this suffix gets when none is named (the only profile of a suffix is its
+        default anyway).
     """
 
     name: str
@@ -82,8 +83,9 @@ def profile_for(path, name: str | None) -> Profile:
             raise InputError(f"{path}: the {name} profile writes {profile.suffix} files, not "
                              f"{suffix or '(no suffix)'!r}")
         return profile
-    for profile in _PROFILES.values():
-        if profile.default and profile.suffix == suffix:
+    mine = [p for p in _PROFILES.values() if p.suffix == suffix]
+    for profile in mine:
+        if profile.default or len(mine) == 1:  # a suffix's default, or its only profile
             return profile
     known = sorted({p.suffix for p in _PROFILES.values()})
     raise InputError(f"{path}: cannot write {suffix or '(no suffix)'!r} files; write {', '.join(known)}")

@@ -19,8 +19,9 @@ from ..pattern import Flattening
 from ..predicates import overlap_verdict
 from . import grow
 from .embed import lscm, tutte_embedding
+from .moves import align_to_pins, best_scale, check_lengths, check_pins
 from .numbering import dissection_order, renumber, renumber_connectivity, spatial_order
-from .relax import align_to_pins, best_scale, check_lengths, check_pins, is_isometric, relax
+from .relax import is_isometric, relax
 from .settings import FlattenOptions
 
 __all__ = ["flatten_mesh"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import replace
 
 import numpy as np
@@ -19,7 +20,7 @@ def grain_table(grain, model) -> dict:
     if grain is None:
         return {}
     names = [p.name for p in model.panels]
-    items = grain.items() if hasattr(grain, "items") else [(n, grain) for n in names]
+    items = grain.items() if isinstance(grain, Mapping) else [(n, grain) for n in names]
     out = {}
     for name, direction in items:
         if name not in names:

@@ -42,14 +42,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import shapely
 
-from ..errors import InputError
-from ..measure import signed_areas
 from ..mesh import Connectivity, edge_lengths
-from ..predicates import crossing_segments
 from .embed import LDL, LDLFactor, factorize
 from .energy import ENERGIES, Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, dot, frames
+from .moves import boundary_crossings, edge_index, flip_free_steps, layout_size, safe_move
 
 _WINDOW = 2  # iterations over which progress is judged
 _STAGE_TOLERANCE = 30.0  # a barrier stage ends at this many times the tolerance
@@ -62,7 +59,7 @@ _SEAM_ROUNDS = 20  # most multiplier updates
 _CRUSHED = 1e-3  # "auto": ARAP's layout with a triangle squeezed below this stretch is redone with the hybrid
 _PROBE = 10.0  # "auto" from a far start: the first ARAP run stops at this many times the tolerance
 
-__all__ = ["ENERGIES", "Relaxation", "align_to_pins", "best_scale", "flip_free_steps", "is_isometric", "relax"]
+__all__ = ["ENERGIES", "Relaxation", "is_isometric", "relax"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,84 +86,6 @@ class Relaxation:
     converged: bool
     length_error: float = 0.0
     energy: str = "arap"
-
-
-def flip_free_steps(uv: np.ndarray, faces: np.ndarray, step: np.ndarray, *, horizon: float = np.inf,
-                    corners: tuple | None = None) -> np.ndarray:
-    """Largest ``t`` per triangle such that ``uv + s * step`` keeps it positive for all ``s < t``.
-
-    The signed area along the step is the quadratic ``a2 t**2 + a1 t + a0``
-    (``a0 > 0``); its smallest positive root is returned, ``inf`` if none.
-
-    Parameters
-    ----------
-    uv, step : (n, 2) float64
-    faces : (m, 3) int64
-    horizon : float
-        Only roots below this matter: triangles whose area stays positive up to
-        ``horizon`` get ``inf`` without solving (much faster when most are safe).
-    corners : tuple of three (m,) int64, optional
-        ``faces``' columns, contiguous, if at hand (faster gathers).
-
-    Returns
-    -------
-    (m,) float64
-    """
-    # Column gathers: several times faster than gathering (m, 3, 2) blocks.
-    i, j, k = corners if corners is not None else (np.ascontiguousarray(faces[:, c]) for c in range(3))
-    x, y = np.ascontiguousarray(uv[:, 0]), np.ascontiguousarray(uv[:, 1])
-    dx, dy = np.ascontiguousarray(step[:, 0]), np.ascontiguousarray(step[:, 1])
-    x0, y0, dx0, dy0 = x.take(i), y.take(i), dx.take(i), dy.take(i)
-    e1x, e1y, e2x, e2y = x.take(j) - x0, y.take(j) - y0, x.take(k) - x0, y.take(k) - y0
-    d1x, d1y, d2x, d2y = dx.take(j) - dx0, dy.take(j) - dy0, dx.take(k) - dx0, dy.take(k) - dy0
-    a0 = e1x * e2y - e1y * e2x
-    a1 = e1x * d2y - e1y * d2x + d1x * e2y - d1y * e2x
-    a2 = d1x * d2y - d1y * d2x
-    t = np.full(len(faces), np.inf)
-    if np.isfinite(horizon):
-        # Positive at both ends of [0, horizon] and not dipping in between: safe.
-        end = (a2 * horizon + a1) * horizon + a0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            vertex = -a1 / (2 * a2)
-            dips = (a2 > 0) & (vertex > 0) & (vertex < horizon) & (a0 - a1 * a1 / (4 * a2) <= 0)
-        risky = np.flatnonzero((end <= 0) | dips)
-    else:
-        risky = np.arange(len(faces))
-    a0, a1, a2 = a0[risky], a1[risky], a2[risky]
-    r_best = np.full(len(risky), np.inf)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        linear = np.abs(a2) <= 1e-14 * np.abs(a0)
-        root = -a0 / a1
-        r_best = np.where(linear & (root > 0), root, r_best)
-        disc = a1 * a1 - 4 * a2 * a0
-        sq = np.sqrt(np.maximum(disc, 0.0))
-        for r in ((-a1 - sq) / (2 * a2), (-a1 + sq) / (2 * a2)):
-            ok = ~linear & (disc >= 0) & (r > 0)
-            r_best = np.where(ok & (r < r_best), r, r_best)
-    t[risky] = r_best
-    return t
-
-
-def best_scale(vertices: np.ndarray, edges: np.ndarray, uv: np.ndarray) -> float:
-    """The uniform factor ``s`` that minimises the summed squared edge strain of ``s * uv``.
-
-    Used on starting layouts that have no scale of their own (Tutte, LSCM),
-    never on a result.
-    """
-    r = np.linalg.norm(uv[edges[:, 1]] - uv[edges[:, 0]], axis=1) / np.linalg.norm(
-        vertices[edges[:, 1]] - vertices[edges[:, 0]], axis=1)
-    return float(r.sum() / (r * r).sum())
-
-
-def align_to_pins(uv: np.ndarray, index: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """Move a layout rigidly (no scaling) so its pinned vertices best fit their targets."""
-    a = uv[index]
-    ca, cb = a.mean(axis=0), target.mean(axis=0)
-    if len(index) < 2:
-        return uv + (cb - ca)
-    u, _, vt = np.linalg.svd((a - ca).T @ (target - cb))
-    rot = vt.T @ np.diag([1.0, np.sign(np.linalg.det(vt.T @ u.T))]) @ u.T
-    return (uv - ca) @ rot.T + cb
 
 
 def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np.ndarray, *,
@@ -241,7 +160,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         free[pin_index] = False
         uv, iterations = _travel_to_pins(faces, conn.loops, conn.edges, edge_lengths(vertices, conn.edges), free, uv,
                                          pin_index, pin_target, max_iterations, progress)
-        if not np.allclose(uv[pin_index], pin_target, rtol=0, atol=1e-9 * _size(uv)):
+        if not np.allclose(uv[pin_index], pin_target, rtol=0, atol=1e-9 * layout_size(uv)):
             uv.setflags(write=False)
             return Relaxation(uv, iterations, False, _length_error(seam, uv), "arap" if energy == "auto" else energy)
         uv[pin_index] = pin_target
@@ -299,31 +218,12 @@ def _seam_term(n, conn, fr, lengths):
     edges, target = lengths[:2]
     groups = lengths[2] if len(lengths) > 2 else None
     edges = np.sort(np.asarray(edges, dtype=np.int64), axis=1)
-    index = _edge_index(conn.edges, edges)
+    index = edge_index(conn.edges, edges)
     faces_of = conn.edge_faces[index]
     side = np.where(faces_of[:, 0] >= 0, faces_of[:, 0], faces_of[:, 1])
     group = np.arange(len(edges)) if groups is None else np.unique(np.asarray(groups), return_inverse=True)[1]
     weight = np.bincount(group, fr.weight[side])
     return EdgeLengths(n, edges, np.asarray(target, dtype=np.float64), group, weight, _SEAM_RHO), index
-
-
-def _edge_rows(table: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """Row of each ``edges`` pair (sorted ends) in the unique edge ``table`` (sorted ends), -1 where absent."""
-    n = int(max(table.max(), edges.max())) + 1
-    keys = table[:, 0] * n + table[:, 1]
-    order = np.argsort(keys, kind="stable")
-    want = edges[:, 0] * n + edges[:, 1]
-    pos = np.minimum(np.searchsorted(keys, want, sorter=order), len(keys) - 1)
-    return np.where(keys[order[pos]] == want, order[pos], -1)
-
-
-def _edge_index(table: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """:func:`_edge_rows`, every pair required; InputError naming the first that is not an edge."""
-    rows = _edge_rows(table, edges)
-    if np.any(rows < 0):
-        bad = edges[np.flatnonzero(rows < 0)[0]]
-        raise InputError(f"held length on ({int(bad[0])}, {int(bad[1])}), which is not an edge of the mesh")
-    return rows
 
 
 def _length_error(seam, uv) -> float:
@@ -486,7 +386,7 @@ class _Minimiser:
     def __call__(self, uv, barrier, max_iterations):
         """Run; returns ``(uv, iterations, converged)``."""
         mu = float(barrier)
-        self.size = _size(uv)
+        self.size = layout_size(uv)
         value, grad, parts = self.evaluate(uv, mu)
         lu, hgrad, memory = self.factor(uv, mu), None, _Memory()
         since_refresh, recent, rounds = 0, [value], 0
@@ -551,7 +451,7 @@ class _Minimiser:
         while step > smallest:
             cand = uv + step * direction
             new_value, new_grad, parts = self.evaluate(cand, mu)
-            if new_value <= value + 1e-4 * step * slope and _boundary_crossings(cand, self.loops) is None:
+            if new_value <= value + 1e-4 * step * slope and boundary_crossings(cand, self.loops) is None:
                 return True, (cand, new_value, new_grad, parts)
             step *= 0.5
         return False, None
@@ -570,7 +470,7 @@ def _travel_to_pins(faces, loops, e, length, free, uv, pin_index, pin_target, ma
     laplacian = _laplacian(n, e, weight)
     lu = factorize(laplacian[free][:, free])
     coupling = laplacian[free][:, ~free]
-    size = _size(uv)
+    size = layout_size(uv)
     iterations = 0
     while iterations < max_iterations and not np.allclose(uv[pin_index], pin_target, rtol=0, atol=1e-9 * size):
         iterations += 1
@@ -584,7 +484,7 @@ def _travel_to_pins(faces, loops, e, length, free, uv, pin_index, pin_target, ma
         target[pin_index] = pin_target
         # The pinned block in vertex order (``~free`` is sorted; ``pin_index`` need not be).
         target[free] = lu.solve(rhs[free] - coupling @ target[~free])
-        moved = _safe_move(faces, loops, uv, target)
+        moved = safe_move(faces, loops, uv, target)
         if progress is not None:
             progress(iterations, max_iterations)
         if moved is uv:
@@ -631,101 +531,3 @@ def _degrees(n: int, edges: np.ndarray, weight: np.ndarray, *, anchor: float = 0
     diagonal = np.bincount(edges[:, 0], weight, n) + np.bincount(edges[:, 1], weight, n)
     diagonal[0] += anchor
     return diagonal
-
-
-def _size(uv: np.ndarray) -> float:
-    return float(np.ptp(uv, axis=0).max()) or 1.0
-
-
-def _safe_move(faces: np.ndarray, loops, uv: np.ndarray, target: np.ndarray, *, tries: int = 40) -> np.ndarray:
-    """Move towards ``target`` as far as possible, vertex by vertex, staying one-to-one.
-
-    Returns ``uv`` itself (the same object) when no move is possible.
-    """
-    step = target - uv
-    n = len(uv)
-    alpha = np.ones(n)
-    per_face = np.minimum(0.9 * flip_free_steps(uv, faces, step, horizon=1.0 / 0.9), 1.0)
-    np.minimum.at(alpha, faces.ravel(), np.repeat(per_face, 3))
-    for attempt in range(2 * tries):
-        cand = uv + alpha[:, None] * step
-        bad = ~(signed_areas(cand, faces) > 0)
-        crossing = None if bad.any() else _boundary_crossings(cand, loops)
-        if not bad.any() and crossing is None:
-            return cand
-        if attempt >= tries:
-            # Local cuts did not settle it: shrink the whole step instead (the
-            # zero step is always safe, so this ends or returns uv).
-            alpha *= 0.5
-        elif bad.any():
-            alpha[faces[bad].ravel()] *= 0.5
-        elif len(crossing):
-            alpha[crossing] *= 0.25
-        else:
-            alpha *= 0.5
-    return uv
-
-
-def _boundary_crossings(uv: np.ndarray, loops):
-    """None when the flat loops form a valid polygon; else the vertices of the
-    boundary segments that cross another one (possibly empty)."""
-    rings = [uv[loop] for loop in loops]
-    if shapely.is_valid(shapely.Polygon(rings[0], rings[1:])):
-        return None
-    _, pair, i, j = crossing_segments(uv, loops)
-    return np.unique(np.concatenate([pair[i].ravel(), pair[j].ravel()]))
-
-
-def check_lengths(lengths, conn: Connectivity, name: str, *, numbering=None):
-    """Validate ``lengths = (edges, targets[, groups])``; returns ``(int64 (k, 2), float64 (k,)[, int64 (k,)])``.
-
-    Every pair must be an edge of the mesh and every target a positive finite length.
-    ``numbering`` ``(n,) int64``, if given, renumbers the vertices (input vertex ``j`` is vertex
-    ``numbering[j]`` of ``conn``); the edges come back renumbered, messages name the input's.
-    """
-    try:
-        edges, targets, *rest = lengths
-        edges = np.asarray(edges)
-        targets = np.asarray(targets, dtype=np.float64)
-        groups = np.asarray(rest[0]) if rest else None
-    except (TypeError, ValueError):
-        raise InputError(f"{name}: lengths must be (edges (k, 2), lengths (k,)[, groups (k,)])") from None
-    if len(rest) > 1 or (groups is not None and (groups.shape != targets.shape
-                                                 or not np.issubdtype(groups.dtype, np.integer))):
-        raise InputError(f"{name}: lengths must be (edges (k, 2), lengths (k,)[, integer groups (k,)])")
-    if edges.ndim != 2 or edges.shape[1:] != (2,) or targets.shape != (len(edges),):
-        raise InputError(f"{name}: lengths must be (edges (k, 2), lengths (k,)), got shapes {edges.shape} and "
-                         f"{targets.shape}")
-    if len(edges) and (not np.issubdtype(edges.dtype, np.integer) or edges.min() < 0
-                       or edges.max() >= conn.n_vertices):
-        raise InputError(f"{name}: held edges must be vertex indices in [0, {conn.n_vertices})")
-    if not np.all(np.isfinite(targets) & (targets > 0)):
-        raise InputError(f"{name}: held lengths must be positive finite numbers")
-    edges = edges.astype(np.int64)
-    inner = edges if numbering is None else numbering[edges]
-    index = _edge_rows(conn.edges, np.sort(inner, axis=1))
-    if np.any(index < 0):
-        bad = edges[np.flatnonzero(index < 0)[0]]
-        raise InputError(f"{name}: held length on ({int(bad[0])}, {int(bad[1])}), which is not an edge of the mesh")
-    edges = inner
-    return (edges, targets) if groups is None else (edges, targets, groups.astype(np.int64))
-
-
-def check_pins(pins, n: int, name: str):
-    """Validate ``pins = (index, positions)``; returns ``(int64 (k,), float64 (k, 2))``."""
-    try:
-        index, positions = pins
-        index = np.asarray(index)
-        positions = np.asarray(positions, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError(f"{name}: pins must be (vertex indices (k,), positions (k, 2))") from None
-    if index.ndim != 1 or positions.shape != (len(index), 2) or len(index) == 0:
-        raise InputError(f"{name}: pins must be (vertex indices (k,), positions (k, 2)) with k >= 1, "
-                         f"got shapes {index.shape} and {positions.shape}")
-    if not np.issubdtype(index.dtype, np.integer) or index.min() < 0 or index.max() >= n:
-        raise InputError(f"{name}: pinned vertex indices must be integers in [0, {n})")
-    if len(np.unique(index)) != len(index):
-        raise InputError(f"{name}: a vertex is pinned twice")
-    if not np.all(np.isfinite(positions)):
-        raise InputError(f"{name}: pin positions must be finite")
-    return index.astype(np.int64), positions

@@ -7,6 +7,7 @@ declarations (:meth:`FlattenOptions.checked`).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,7 +50,7 @@ def parse_ease(text: str) -> Ease:
 
 def _grain(value, option):
     """A 3D direction, or a mapping of panel names to 3D directions (names checked against the model later)."""
-    if hasattr(value, "items"):
+    if isinstance(value, Mapping):
         return {str(name): _direction(d, f"{option}[{name!r}]") for name, d in value.items()}
     return _direction(value, option)
 

@@ -11,6 +11,7 @@ The piece lies where the panel lies (``FlatPanel.uv``).
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,7 +63,7 @@ def _segment_seams(pattern: Pattern, index: int) -> dict:
         seam = fs.seam
         for p, idx in zip(seam.panels, seam.vertices):
             if p == source:
-                for a, b in zip(idx[:-1], idx[1:]):
+                for a, b in itertools.pairwise(idx):
                     out[(int(a), int(b))] = seam.id
     return out
 

@@ -271,8 +271,8 @@ class Piece:
 
     @property
     def area(self) -> float:
-        """Cut area, mm² (the outline less the holes)."""
-        return float(self.polygon.area)
+        """Cut area, mm²: the outline less the holes, exactly (arcs as arcs)."""
+        return self.outline.area - sum(h.area for h in self.holes)
 
     @property
     def bounds(self) -> tuple:

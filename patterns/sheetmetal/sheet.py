@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-
 from ..errors import InputError
 from ..tessellate.topology import Topology
 from .faces import normal, point, uv_mid
@@ -170,4 +169,3 @@ def check_volume(shape, sheet: Sheet, faces, curvature: dict, meshed: dict, name
         raise InputError(f"{name}: not a sheet of constant thickness: the solid holds {volume:.0f} mm³, a "
                          f"{t:g} mm sheet over its skin {expected:.0f} mm³ (a machined block or a "
                          f"part of several thicknesses)")
-    return None

@@ -26,6 +26,7 @@ build123d / OpenCascade is imported only when a CAD object is meshed.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,7 +96,7 @@ def tessellate_face(face, *, tolerance: float = 0.05, angular_tolerance: float =
 
 def _panel_groups(value, option):
     """``{name: [CAD face index, ...]}``, checked (indices against the shape later); the CLI gives pairs."""
-    if not hasattr(value, "items"):
+    if not isinstance(value, Mapping):
         try:
             value = dict(value)  # [(name, [indices]), ...] from repeated --panel flags
         except (TypeError, ValueError):
@@ -186,7 +187,7 @@ def mesh_shape(shape, options: MeshingOptions | None = None, *, name: str = "sha
     from OCP.TopoDS import TopoDS_Shape
 
     opts = MeshingOptions.of(options, keywords, name=name)
-    wrapped = shape.wrapped if hasattr(shape, "wrapped") else shape
+    wrapped = getattr(shape, "wrapped", shape)  # a build123d shape wraps its OCP one
     if not isinstance(wrapped, TopoDS_Shape) or wrapped.IsNull():
         raise InputError(f"{name}: expected a build123d shape or an OCP TopoDS_Shape, got {type(shape).__name__}")
     if opts.sew:

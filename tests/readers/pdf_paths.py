@@ -1,8 +1,10 @@
-"""The stroked line segments of a PDF that LibreCAD's ``dxf2pdf`` printed, in millimetres on paper.
+"""The stroked line segments of a PDF that LibreCAD's ``dxf2pdf`` or Inkscape printed, in millimetres on paper.
 
 LibreCAD (Qt's PDF engine) writes each page as one content stream: a transformation
 (``a b c d e f cm``), then runs of ``r g b SCN`` (the stroke colour), ``x y m`` /
 ``x y l`` (move, line) and ``S`` (stroke).  Arcs and text come as many short lines.
+Inkscape (cairo) writes ``RG`` colours and draws arcs as cubic Béziers (``c``), each
+sampled here as 32 segments, and closes paths with ``h``.
 This reads exactly those operators, applies the current matrix (``q``/``Q`` save and
 restore it) and returns every stroked segment with its colour, in mm (1 pt = 25.4/72 mm),
 so a test can measure what LibreCAD drew: at ``--scale 1`` a 200 mm edge must come out
@@ -60,6 +62,14 @@ def segments(path) -> dict:
                 point = _apply(ctm, operands[-2:])
                 path_segments.append((current, point))
                 current = point
+            elif op == "c" and len(operands) >= 6 and current is not None:
+                given = operands[-6:]
+                controls = [current] + [_apply(ctm, given[2 * k:2 * k + 2]) for k in range(3)]
+                t = np.linspace(0.0, 1.0, 33)[:, None]
+                c0, c1, c2, c3 = (np.array(c) for c in controls)
+                pts = (1 - t) ** 3 * c0 + 3 * (1 - t) ** 2 * t * c1 + 3 * (1 - t) * t**2 * c2 + t**3 * c3
+                path_segments.extend((tuple(a), tuple(b)) for a, b in zip(pts[:-1], pts[1:]))
+                current = tuple(pts[-1])
             elif op == "h" and current is not None and start is not None:
                 path_segments.append((current, start))
                 current = start
