@@ -31,9 +31,8 @@ REPO = Path(__file__).resolve().parent.parent
 SAMPLES = REPO / "samples"
 
 
-def pieces():
-    return Pattern.combined([patterns.flatten(patterns.load(SAMPLES / f"{n}.step"))
-                             for n in ("cup", "duct_transition", "hopper")])
+def parts():
+    return [patterns.flatten(patterns.load(SAMPLES / f"{n}.step")) for n in ("cup", "duct_transition", "hopper")]
 
 
 def old_nester(commit: str):
@@ -48,9 +47,15 @@ def old_nester(commit: str):
     return module
 
 
-def checked_gap(pattern, gap: float, width: float) -> float:
+def outlines(nest) -> list:
+    """The placed outlines of a nest: sparrow's pieces, or the previous nester's laid-out pattern's panels."""
+    if hasattr(nest, "pieces"):
+        return [shapely.Polygon(p.outline.points()) for p in nest.pieces]
+    return [shapely.Polygon(f.uv[f.loops[0]]) for f in nest.pattern.panels]
+
+
+def checked_gap(polys, gap: float, width: float) -> float:
     """The least distance between two placed outlines, after checking every piece lies on the roll."""
-    polys = [shapely.Polygon(f.uv[f.loops[0]]) for f in pattern.panels]
     x = np.concatenate([np.asarray(p.exterior.coords)[:, 0] for p in polys])
     assert x.min() >= -1e-6 and x.max() <= width + 1e-6
     tree = shapely.STRtree(polys)
@@ -66,9 +71,10 @@ def main(argv=None) -> int:
     parser.add_argument("--budget", type=int, nargs="+", default=[10, 30], help="sparrow's time budgets, s")
     parser.add_argument("--no-old", action="store_true", help="leave the previous nester out (it takes a minute)")
     args = parser.parse_args(argv)
-    base = pieces()
-    four = base.with_copies([4] * len(base.panels))
-    print(f"36 pieces ({len(base.panels)} panels x 4), area {sum(f.area for f in four.panels) / 1e6:.3f} m^2; "
+    base = parts()
+    combined = Pattern.combined(base)  # the previous nester took one pattern
+    four = combined.with_copies([4] * len(combined.panels))
+    print(f"36 pieces ({len(combined.panels)} panels x 4), area {sum(f.area for f in four.panels) / 1e6:.3f} m^2; "
           f"roll 1500 mm, gap 10 mm\n")
     print("| nester | turns | budget s | roll used mm | efficiency | seconds | least gap mm | rerun |")
     print("|---|---|---|---|---|---|---|---|")
@@ -79,7 +85,7 @@ def main(argv=None) -> int:
             start = time.perf_counter()
             nest = old.layout(four, width=1500.0, gap=10.0, allow_rotation=True, respect_grain=grain)
             seconds = time.perf_counter() - start
-            gap = checked_gap(nest.pattern, 10.0, 1500.0)
+            gap = checked_gap(outlines(nest), 10.0, 1500.0)
             rows[("old", turns)] = (nest.length, seconds)
             print(f"| bottom-left ({args.old}) | {turns} | - | {nest.length:.1f} | {nest.efficiency:.3f} | "
                   f"{seconds:.1f} | {gap:.2f} | - |", flush=True)
@@ -88,11 +94,11 @@ def main(argv=None) -> int:
             runs = []
             for _ in range(2):
                 start = time.perf_counter()
-                nest = base.layout(width=1500.0, gap=10.0, copies=4, rotations=turns, time_limit=budget,
-                                   cache=False)  # the search itself, timed; the rerun, searched anew
+                nest = patterns.layout(base, width=1500.0, gap=10.0, copies=4, rotations=turns, time_limit=budget,
+                                       cache=False)  # the search itself, timed; the rerun, searched anew
                 runs.append((nest, time.perf_counter() - start))
             nest, seconds = runs[0]
-            gap = checked_gap(nest.pattern, 10.0, 1500.0)
+            gap = checked_gap(outlines(nest), 10.0, 1500.0)
             same = "same" if runs[1][0].length == nest.length else f"{runs[1][0].length:.1f}"
             old = rows.get(("old", turns))
             vs = f" ({nest.length / old[0] - 1:+.1%} length, {seconds / old[1]:.2f}x time)" if old else ""
@@ -103,8 +109,8 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|")
     for budget in args.budget[:1]:
         start = time.perf_counter()
-        nest = base.layout(sheet=(2500.0, 1250.0), gap=10.0, copies=4, rotations="quarter", time_limit=budget,
-                           cache=False)
+        nest = patterns.layout(base, sheet=(2500.0, 1250.0), gap=10.0, copies=4, rotations="quarter",
+                               time_limit=budget, cache=False)
         seconds = time.perf_counter() - start
         print(f"| {budget} | {len(nest.sheets)} | " + ", ".join(f"{s.usage:.1%} ({len(s.pieces)} pieces)"
                                                           for s in nest.sheets)
