@@ -211,7 +211,8 @@ def _inkscape_pdf(svg, tmp_path):
         pytest.skip("inkscape is not installed (.ci/run installs it with apt-get)")
     pdf = tmp_path / (svg.stem + ".pdf")
     proc = subprocess.run(["inkscape", str(svg), "--export-type=pdf", f"--export-filename={pdf}"],
-                          capture_output=True, text=True, timeout=120, env={"HOME": str(tmp_path), "PATH": "/usr/bin"})
+                          capture_output=True, text=True, timeout=120, env={"HOME": str(tmp_path), "PATH": "/usr/bin"},
+                          check=False)
     assert proc.returncode == 0 and pdf.exists(), proc.stderr[-2000:]
     return pdf
 
@@ -296,3 +297,14 @@ def test_a_blank_that_cannot_be_cut_is_written_by_no_profile_but_the_report(tmp_
     data = json.loads((tmp_path / "x.json").read_text())
     assert not data["ok"] and data["findings"][0]["code"] == "flanges-overlap"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.json"]
+
+
+def test_the_report_gives_each_label_where_the_dxf_draws_it(cup, tmp_path):
+    patterns.write(cup, tmp_path / "c.dxf")
+    patterns.write(cup, tmp_path / "c.json")
+    texts = [(t.dxf.text, np.array(t.dxf.align_point)[:2]) for t in ezdxf.readfile(tmp_path / "c.dxf").modelspace().query("TEXT")]
+    data = json.loads((tmp_path / "c.json").read_text())
+    reported = [(label["text"], np.array(label["at"])) for p in data["pieces"] for label in p["labels"]]
+    assert len(reported) == len(texts) > 8
+    for text, at in reported:  # each at a text of the DXF saying the same, within the report's 0.1 um
+        assert min(np.abs(a - at).max() for t, a in texts if t == text) < 1e-4

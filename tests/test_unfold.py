@@ -535,3 +535,27 @@ def test_a_mesh_is_no_part_to_unfold_and_a_bend_table_is_never_overwritten(tmp_p
     (folder / "dish.obj").symlink_to(Path(__file__).resolve().parent.parent / "samples" / "dish.obj")
     assert main(["batch", str(folder), "-o", str(tmp_path / "out"), "--unfold"]) == 2
     assert "no CAD (STEP, BREP, IGES) files in this folder" in capsys.readouterr().err
+
+
+def test_a_batch_of_exact_brackets_flattens_ok(tmp_path):
+    """The L, U and Z brackets flattened face by face in a batch: every row ``ok`` (the seams of exact
+    developments judged on their exact lengths), every part's report ok."""
+    from patterns.samples import bracket
+
+    folder = tmp_path / "in"
+    folder.mkdir()
+    for name, profile in (("L", None), ("U", [(50, 30), (50, 0), (0, 0), (0, 30)]),
+                          ("Z", [(-40, 0), (0, 0), (0, 30), (40, 30)])):
+        if profile is None:
+            part = bracket()
+        else:
+            with bd.BuildLine() as line:
+                bd.FilletPolyline(*profile, radius=4.0)
+            path = line.wire()
+            plane = bd.Plane(origin=path.position_at(0), x_dir=(0, 0, 1), z_dir=path.tangent_at(0))
+            part = bd.sweep(plane * bd.Rectangle(40, 2.0), path=path, transition=bd.Transition.RIGHT)
+        bd.export_step(part, str(folder / f"{name}.step"))
+    result = patterns.batch(folder, tmp_path / "out", jobs=2, quiet=True)
+    assert [(r.file, r.status) for r in result.rows] == [("L.step", "ok"), ("U.step", "ok"), ("Z.step", "ok")]
+    for name in "LUZ":
+        assert json.loads((tmp_path / "out" / f"{name}.json").read_text())["ok"]

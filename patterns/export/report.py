@@ -5,8 +5,9 @@ what the pieces were made from (``patterns.Report.to_dict``: verdict, limits,
 panels, seams, blanks, findings) and, under ``pieces``, each piece as the DXF
 and SVG of the same drawing draw it -- outline and holes as ``[x, y, bulge]``
 rows, sew lines, notches, drill holes, grain, bend lines with direction,
-angle, inside radius and K-factor, seam sides, strain, findings -- every
-coordinate in mm in the DXF's frame (the drawing's first quadrant).
+angle, inside radius and K-factor, seam sides, the labels as the DXF places
+them (in mm), strain, findings -- every coordinate in mm in the DXF's frame
+(the drawing's first quadrant).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import json
 import numpy as np
 
 from ..files import atomic_output
-from ..pieces import MARGIN, Drawing, Piece
+from ..pieces import MARGIN, Drawing, Piece, piece_labels
 from .options import WriteOptions
 
 __all__ = ["REPORT_SCHEMA", "piece_dict", "write"]
@@ -54,6 +55,8 @@ def piece_dict(piece: Piece) -> dict:
                    "allowance_mm": None if b.allowance is None else round(b.allowance, 4)} for b in piece.bends],
         "seams": [{"seam": s.seam, "side": s.side, "length_3d_mm": s.length_3d, "length_flat_mm": s.length_flat}
                   for s in piece.seams],
+        "labels": [{"text": label.text, "at": _xy(label.at), "height": round(label.height, 4),
+                    "angle_deg": round(label.angle, 4), "kind": label.kind} for label in piece_labels(piece)],
         "strain": None if piece.strain is None else {"rms": piece.strain.rms, "p95": piece.strain.p95,
                                                      "p99": piece.strain.p99, "max": piece.strain.max},
         "findings": [f.to_dict() for f in piece.findings],

@@ -13,6 +13,7 @@ so a test can measure what LibreCAD drew: at ``--scale 1`` a 200 mm edge must co
 
 from __future__ import annotations
 
+import itertools
 import re
 import zlib
 from collections import defaultdict
@@ -68,7 +69,7 @@ def segments(path) -> dict:
                 t = np.linspace(0.0, 1.0, 33)[:, None]
                 c0, c1, c2, c3 = (np.array(c) for c in controls)
                 pts = (1 - t) ** 3 * c0 + 3 * (1 - t) ** 2 * t * c1 + 3 * (1 - t) * t**2 * c2 + t**3 * c3
-                path_segments.extend((tuple(a), tuple(b)) for a, b in zip(pts[:-1], pts[1:]))
+                path_segments.extend((tuple(a), tuple(b)) for a, b in itertools.pairwise(pts))
                 current = tuple(pts[-1])
             elif op == "h" and current is not None and start is not None:
                 path_segments.append((current, start))
