@@ -95,6 +95,7 @@ def _parser() -> argparse.ArgumentParser:
     from .nesting import NestOptions
     from .options import add_arguments
     from .pieces import PieceOptions
+    from .pieces.options import PATTERN_ONLY
     from .reading import LoadOptions
     from .sheetmetal import UnfoldOptions
 
@@ -124,7 +125,7 @@ def _parser() -> argparse.ArgumentParser:
                                help="write the JSON report here (the check and every piece, in the DXF's frame)")
 
     def output(p, *, blank=False):
-        add_arguments(p.add_argument_group("pieces"), PieceOptions, skip=_PATTERN_ONLY if blank else ())
+        add_arguments(p.add_argument_group("pieces"), PieceOptions, skip=PATTERN_ONLY if blank else ())
         add_arguments(p.add_argument_group("output"), WriteOptions, skip=() if blank else ("units",))
         add_arguments(p.add_argument_group("nesting (sparrow)"), NestOptions)
 
@@ -174,11 +175,6 @@ def _parser() -> argparse.ArgumentParser:
     checking(batch, report=False)
     output(batch)
     return parser
-
-
-_PATTERN_ONLY = ("seam_allowance", "seam_corners", "notch_spacing", "notch_style", "bend_spacing", "arcs",
-                 "arc_tolerance", "strain_layer")
-"""Piece options that only a flattened pattern has (seams, rulings, fitted arcs, strain)."""
 
 
 def _records(args, name=None):

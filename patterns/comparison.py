@@ -13,6 +13,7 @@ other (Hausdorff distance).
 
 from __future__ import annotations
 
+import itertools
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -75,7 +76,7 @@ def _bulged(rows: np.ndarray, closed: bool, tolerance: float) -> np.ndarray:
     if closed:
         return Loop.of_vertices(rows).points(tolerance)
     pts = [rows[0, :2]]
-    for (x0, y0, bulge), (x1, y1, _) in zip(rows[:-1], rows[1:]):
+    for (x0, y0, bulge), (x1, y1, _) in itertools.pairwise(rows):
         if bulge:
             pts.extend(Arc.from_bulge((x0, y0), (x1, y1), bulge).points(tolerance)[1:])
         else:

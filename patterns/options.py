@@ -26,7 +26,8 @@ import numpy as np
 from .errors import InputError
 from .units import LARGEST_LENGTH
 
-__all__ = ["Options", "Spec", "add_arguments", "check_number", "cli_flags", "from_arguments", "is_number", "option"]
+__all__ = ["Options", "Spec", "add_arguments", "check_number", "cli_flags", "from_arguments", "from_text", "is_number",
+           "option"]
 
 
 def is_number(value, *, integer: bool = False) -> bool:
@@ -349,3 +350,41 @@ def cli_flags(record: type) -> dict:
             negated = isinstance(f.default, bool) and f.default
             out[f.name] = (spec.flag or "--no-" + f.name.replace("_", "-")) if negated else flag_of(f.name, spec)
     return out
+
+
+def _parse_text(spec: Spec, default, text: str):
+    """One value from its text, as the command line parses it (before the record checks it)."""
+    if spec.parse is not None:
+        return spec.parse(text)
+    if spec.integer:
+        return int(text)
+    if spec.choices is None and (spec.low is not None or spec.high is not None or is_number(default)):
+        return float(text)
+    return text
+
+
+def from_text(record: type, texts: dict, *, name: str | None = None, separator: str = ";"):
+    """The ``record`` from option values given as text (a CAD document's string properties, a form's fields).
+
+    ``texts`` is ``{option name: text}``; an empty text leaves the option at its default; a repeatable
+    option takes its items separated by ``separator``.  Each text is parsed as the command line parses
+    its flag, then the record checks every value (:meth:`Options.of`): one declaration, one validator.
+    """
+    values = {}
+    for f in fields(record):
+        spec = f.metadata.get("spec")
+        text = texts.get(f.name)
+        if spec is None or text is None or not str(text).strip():
+            continue
+        try:
+            if spec.repeat:
+                values[f.name] = [_parse_text(spec, f.default, item.strip()) for item in str(text).split(separator)
+                                  if item.strip()]
+            elif isinstance(f.default, bool):
+                values[f.name] = str(text).strip().lower() in ("1", "true", "yes", "on")
+            else:
+                values[f.name] = _parse_text(spec, f.default, str(text).strip())
+        except ValueError as exc:
+            prefix = f"{name}: " if name else ""
+            raise InputError(f"{prefix}{f.name}: {exc}") from None
+    return record.of(None, values, name=name)

@@ -1,7 +1,9 @@
 """Every code block of README.md and docs/*.md runs, so the documentation cannot go stale.
 
 Python blocks of one file run in order in one namespace, in a fresh folder where
-``samples/`` is the repository's.  Shell blocks run their ``patterns`` commands
+``samples/`` is the repository's; those of docs/freecad.md run so inside FreeCAD (``freecadcmd``, this
+interpreter's packages in front of its path, as that page has a user do), skipped where FreeCAD is
+absent.  Shell blocks run their ``patterns`` commands
 with this interpreter's entry point and must exit 0 (or the code a ``# exit N``
 comment gives).  JSON blocks must parse.  A block that cannot run in a test
 says so in the markdown, on the line just before its fence::
@@ -77,10 +79,40 @@ def _patterns_command() -> list[str]:
     return [sys.executable, "-m", "patterns"]
 
 
+FREECAD_DOC = REPO / "docs" / "freecad.md"
+
+
+@pytest.fixture(scope="module")
+def freecad_blocks(tmp_path_factory):
+    """Every Python block of docs/freecad.md run in order inside freecadcmd: ``{line: "ok" or traceback}``."""
+    import shutil
+    import sysconfig
+
+    if shutil.which("freecadcmd") is None:
+        from .test_dxf_pattern import _installed_by_ci
+
+        if "freecad" in _installed_by_ci():
+            pytest.fail("freecadcmd is missing although .ci/run installed FreeCAD")
+        pytest.skip("FreeCAD is not installed (.ci/run installs it with apt-get)")
+    folder = tmp_path_factory.mktemp("freecad-docs")
+    (folder / "samples").symlink_to(REPO / "samples")
+    blocks = [(line, code) for line, lang, code, mark, _ in _blocks(FREECAD_DOC) if lang == "python" and mark != "skip"]
+    (folder / "blocks.json").write_text(json.dumps(blocks))
+    env = dict(os.environ, PATTERNS_SITE=sysconfig.get_paths()["purelib"], BLOCKS=str(folder / "blocks.json"),
+               OUT=str(folder / "out.json"), HOME=str(folder))
+    proc = subprocess.run(["freecadcmd", str(Path(__file__).parent / "readers" / "freecad_docs_run.py")], cwd=folder,
+                          capture_output=True, text=True, env=env, timeout=900, check=False)
+    assert (folder / "out.json").exists(), proc.stdout[-3000:] + proc.stderr[-3000:]
+    return json.loads((folder / "out.json").read_text())
+
+
 @pytest.mark.parametrize(("path", "line", "lang", "code"), list(_cases()))
-def test_code_block_runs(path, line, lang, code, workdirs):
+def test_code_block_runs(path, line, lang, code, workdirs, request):
     folder, namespace = workdirs(path)
-    if lang == "python":
+    if lang == "python" and path == FREECAD_DOC:
+        result = request.getfixturevalue("freecad_blocks")[str(line)]
+        assert result == "ok", result
+    elif lang == "python":
         old = Path.cwd()
         os.chdir(folder)
         try:

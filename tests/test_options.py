@@ -59,6 +59,7 @@ def test_dxf_lengths_must_be_finite(tmp_path, option):
 import dataclasses  # noqa: E402
 
 from patterns import cli  # noqa: E402
+from patterns.pieces.options import PATTERN_ONLY  # noqa: E402
 from patterns.options import cli_flags, from_arguments  # noqa: E402
 
 RECORDS = {"load": patterns.LoadOptions, "flatten": patterns.FlattenOptions, "check": patterns.CheckOptions,
@@ -68,7 +69,7 @@ COMMANDS = {"flatten": ("load", "flatten", "check", "pieces", "write", "nest"),
             "batch": ("load", "flatten", "unfold", "check", "pieces", "write", "nest", "batch"),
             "unfold": ("unfold", "pieces", "write", "nest"),
             "check": ("load", "flatten", "check"), "info": ("load",)}
-FROM_OTHER_FLAGS = {("pieces", name) for name in cli._PATTERN_ONLY}
+FROM_OTHER_FLAGS = {("pieces", name) for name in PATTERN_ONLY}
 """Options a command does not take: a blank has no seams, rulings or strain (``patterns unfold``)."""
 
 

@@ -17,8 +17,8 @@ import numpy as np
 from ..errors import InputError
 from ..options import Options, check_number, is_number, option
 
-__all__ = ["MAX_MARKS", "MAX_SEAM_ALLOWANCE", "NOTCH_STYLES", "SEAM_CORNERS", "SMALLEST_PANEL", "PieceOptions",
-           "check_marks"]
+__all__ = ["MAX_MARKS", "MAX_SEAM_ALLOWANCE", "NOTCH_STYLES", "PATTERN_ONLY", "SEAM_CORNERS", "SMALLEST_PANEL",
+           "PieceOptions", "check_marks"]
 
 NOTCH_STYLES = ("slit", "v")
 """Notch shapes: a slit across the seam allowance, or a V."""
@@ -82,6 +82,11 @@ class PieceOptions(Options):
         """The widest seam allowance asked for, mm."""
         a = self.seam_allowance
         return max(a.values(), default=0.0) if isinstance(a, Mapping) else float(a)
+
+
+PATTERN_ONLY = ("seam_allowance", "seam_corners", "notch_spacing", "notch_style", "bend_spacing", "arcs",
+                "arc_tolerance", "strain_layer")
+"""The options only a flattened pattern's pieces have (seams, rulings, fitted arcs, strain): a blank takes the others."""
 
 
 def check_marks(name: str, seam_lengths, panel_sizes, options: PieceOptions) -> None:
