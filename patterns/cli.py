@@ -580,8 +580,28 @@ def _on_sigterm(signum, frame):
     raise Terminated()
 
 
+def _foreign_home() -> None:
+    """``sudo -u user patterns ...`` without ``-H`` keeps root's HOME, which the user cannot read: ezdxf fails
+    at import reading its settings and its font cache there, and matplotlib warns.  Then none looks there:
+    the settings and caches (``XDG_CONFIG_HOME``, ``XDG_CACHE_HOME``, ``MPLCONFIGDIR``; the marker cache too)
+    go to a folder of this run's, removed at exit."""
+    import atexit
+    import shutil
+    import tempfile
+
+    home = os.path.expanduser("~")
+    if not os.path.isdir(home) or os.access(home, os.R_OK | os.X_OK):
+        return
+    own = tempfile.mkdtemp(prefix="patterns-home-")
+    atexit.register(shutil.rmtree, own, ignore_errors=True)
+    for name in ("XDG_CONFIG_HOME", "XDG_CACHE_HOME", "MPLCONFIGDIR"):
+        if name not in os.environ or not os.access(os.environ[name], os.R_OK | os.W_OK | os.X_OK):
+            os.environ[name] = own
+
+
 def main(argv=None) -> int:
     """Run the command line; returns the exit code."""
+    _foreign_home()
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
     argv = [a for a in argv if a != "--debug"]  # anywhere on the line

@@ -90,6 +90,7 @@ def output_target(path, *, what: str = "file", inputs=(), error=ExportError) -> 
     _check_name_length(target, shown, error)
     try:
         if target.is_symlink():
+            _check_link_owners(target, shown, what, error)
             target = Path(os.path.realpath(target))  # write through the link: it stays a link to the new file
             _check_name_length(target, shown, error)
         info = os.stat(target)
@@ -115,6 +116,21 @@ def output_target(path, *, what: str = "file", inputs=(), error=ExportError) -> 
         if same_file(target, source):
             raise error(f"{shown}: is an input of this run; writing the {what} there would replace it")
     return target
+
+
+def _check_link_owners(link: Path, shown: str, what: str, error) -> None:
+    """Every link on the way from ``link`` to its file, as the kernel's ``protected_symlinks`` judges links it
+    follows: a link in a sticky, world-writable folder (``/tmp``) is followed only when this user or the
+    folder's owner owns it.  The links are resolved here, not by the kernel, so the rule is kept here."""
+    seen = 0
+    while link.is_symlink() and seen < 40:
+        info, folder = os.lstat(link), os.stat(link.parent if str(link.parent) else ".")
+        shared = folder.st_mode & stat.S_ISVTX and folder.st_mode & stat.S_IWOTH
+        if shared and info.st_uid not in (os.geteuid(), folder.st_uid):
+            raise error(f"{shown}: is a link another user (uid {info.st_uid}) made in a shared folder (sticky, "
+                        f"world-writable: {_show(link.parent)}); the {what} is not written through it")
+        link = link.parent / os.readlink(link)
+        seen += 1
 
 
 def _check_name_length(target: Path, shown: str, error) -> None:

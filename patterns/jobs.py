@@ -40,7 +40,7 @@ from .export.registry import profile_for
 from .files import output_target
 from .flattening import flatten
 from .model import Model
-from .nesting import Layout, layout
+from .nesting import Layout, check_piece_count, layout
 from .pattern import Pattern
 from .pieces import Drawing, check_marks, drawing_of
 from .reading import load
@@ -122,7 +122,8 @@ def check_part(model: Model, records: dict, outputs: dict) -> None:
 
     A flat OBJ holds one panel; ``notch_spacing`` and ``bend_spacing`` must not
     ask for more marks than :data:`patterns.pieces.options.MAX_MARKS` on this part
-    (its seams' 3D lengths, its panels' sizes).
+    (its seams' 3D lengths, its panels' sizes); a nest takes at most
+    :data:`patterns.nesting.MAX_PIECES` pieces.
     """
     pattern_path = outputs.get("pattern")
     if pattern_path is not None and pattern_path.suffix.lower() == ".obj" and len(model.panels) != 1:
@@ -130,6 +131,10 @@ def check_part(model: Model, records: dict, outputs: dict) -> None:
     if "pieces" in records:
         check_marks(model.name, [s.length for s in model.seams],
                     [float(np.ptp(p.vertices, axis=0).max()) for p in model.panels], records["pieces"])
+    nesting = records.get("nest")
+    if nesting is not None and nesting.active:  # a panel a piece (gores and darts may add more, checked again)
+        quantities = nesting.quantities or {}
+        check_piece_count(model.name, [quantities.get(p.name, nesting.copies) for p in model.panels], nesting)
 
 
 @dataclass(frozen=True, eq=False)

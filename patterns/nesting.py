@@ -29,7 +29,11 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
+import shutil
+import subprocess
+import sys
 import time
 from dataclasses import dataclass, field, replace
 from importlib.metadata import version
@@ -64,6 +68,18 @@ SHEET_SPACING = 100.0
 SIMPLIFY = 0.05
 """Outlines are offered to sparrow simplified within this, mm (outwards: the gap holds on the true one)."""
 
+MAX_PIECES = 2000
+"""The most pieces one nest takes (copies and mirror images counted).  Sparrow's set-up before its timed search
+grows with the pieces (measured on the cup's panels, 10 s budget: 1,000 pieces 15 s in all, 2,000 pieces 22 s,
+4,000 pieces 38 s and 0.9 GB); 2,000 keeps the whole nest within a minute of the budget."""
+
+SETUP_GRACE = 20.0
+"""Seconds sparrow's process may run past its search budget before it is stopped (its start and set-up), plus
+:data:`SETUP_PER_PIECE` a piece."""
+
+SETUP_PER_PIECE = 0.02
+"""Seconds of set-up allowed a piece past the budget (measured: about 6 ms a piece of the cup)."""
+
 
 def _sheet(value, option_name):
     if value is None:
@@ -91,7 +107,7 @@ def _quantities(value, option_name):
         items = dict(value).items()
     except (TypeError, ValueError):
         raise InputError(f"{option_name} must map panel names to counts, e.g. {{'sleeve': 2}}") from None
-    return {str(k): check_number(n, f"{option_name}[{k!r}]", low=1, high=10000, integer=True) for k, n in items}
+    return {str(k): check_number(n, f"{option_name}[{k!r}]", low=1, high=MAX_PIECES, integer=True) for k, n in items}
 
 
 def _parse_quantity(text: str):
@@ -115,13 +131,14 @@ class NestOptions(Options):
                                 "cutter's clearance)", low=0, high=1000, unit="mm")
     rotations: str = option("grain", "how pieces may turn: grain (0 or 180 degrees: the grain along the roll), "
                                      "quarter (multiples of 90), free, none", choices=ROTATIONS)
-    copies: int = option(1, "pieces of every panel or blank (a part cut this many times)", integer=True, low=1,
-                         high=10000, metavar="N")
+    copies: int = option(1, "pieces of every panel or blank (a part cut this many times; 2000 pieces a nest at "
+                            "most)", integer=True, low=1, high=MAX_PIECES, metavar="N")
     mirror: bool = option(False, "each piece also as its mirror image (left and right)")
     quantities: dict | None = option(None, "pieces of named panels or blanks, over copies (API: {'sleeve': 2}; "
                                            "command line NAME=N, repeatable)", check=_quantities, parse=_parse_quantity,
                                      repeat=True, flag="--quantity", metavar="NAME=N")
-    time_limit: int = option(10, "seconds the nester searches (sparrow); longer may save a little material",
+    time_limit: int = option(10, "seconds the nest takes (sparrow's search, on a roll or all the sheets, plus its "
+                                 "set-up); longer may save a little material",
                              integer=True, low=1, high=86400, flag="--nest-time", metavar="S")
     seed: int = option(0, "the search's seed", integer=True, low=0, high=2**32 - 1, flag="--nest-seed",
                        metavar="N")
@@ -133,6 +150,11 @@ class NestOptions(Options):
         super().__post_init__()
         if self.width is not None and self.sheet is not None:
             raise InputError("nest on a roll (width) or on sheets (sheet), not both")
+        room = self.gap + 2 * self.margin  # a gap wider than the stock: refused before sparrow sees it
+        if self.width is not None and room >= self.width or self.sheet is not None and room >= min(self.sheet):
+            stock = f"{self.width:g} mm roll" if self.sheet is None else f"{self.sheet[0]:g} x {self.sheet[1]:g} mm sheet"
+            raise InputError(f"nest_gap {self.gap:g} mm (and margin {self.margin:g} mm each side) is as wide as the "
+                             f"{stock}: no two pieces could lie side by side")
 
     @property
     def active(self) -> bool:
@@ -261,12 +283,14 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
         A piece that fits the roll or sheet in no allowed orientation, or a
         result that fails the shapely check (never returned).
     """
+    deadline = time.monotonic() + 0  # set below, once the options are known
     nest_fields = set(NestOptions.__dataclass_fields__)
     items = list(source) if isinstance(source, (list, tuple)) else [source]
     name = " + ".join(dict.fromkeys(str(getattr(item, "name", type(item).__name__)) for item in items))
     opts = NestOptions.of(options, {k: v for k, v in keywords.items() if k in nest_fields}, name=name)
     if not opts.active:
         raise InputError(f"{name}: give a roll width or a sheet to nest on")
+    deadline += opts.time_limit
     base = pieces_of(source, pieces, **{k: v for k, v in keywords.items() if k not in nest_fields})
     names = [p.name for p in base]
     counts = [opts.copies] * len(names)
@@ -274,22 +298,31 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
         if piece_name not in names:
             raise InputError(f"{name}: quantities name piece {piece_name!r}; the pieces are {', '.join(names)}")
         counts[names.index(piece_name)] = n
-    every = _with_copies(base, counts, opts.mirror)
-    shapes = [_outline(piece, opts.margin) for piece in every]
+    check_piece_count(name, counts, opts)
     across = opts.width if opts.width is not None else opts.sheet[1]
     along = None if opts.sheet is None else opts.sheet[0]
-    for piece, shape in zip(every, shapes):
-        _check_fits(name, piece.name, shape, across, along, opts.rotations)
+    every = _with_copies(base, counts, opts.mirror)
+    shapes = [_outline(piece, opts.margin) for piece in every]
+    checked = set()
+    for piece, shape in zip(every, shapes):  # a copy fits as its original does: each outline checked once
+        if (key := shapely.to_wkb(shape)) not in checked:
+            checked.add(key)
+            _check_fits(name, piece.name, shape, across, along, opts.rotations)
     start = time.perf_counter()
-    if opts.sheet is None:
-        placements = _solve(shapes, list(range(len(shapes))), across, opts, name)
-        sheets, stock = (), [(0.0, 0.0, across, None)]
-    else:
-        placements, sheets, stock = _fill_sheets(shapes, every, opts, name)
+    try:
+        placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline)
+        laid = tuple(piece.moved(Motion(*placements[i])) for i, piece in enumerate(every))
+        placed = [_outline(piece, opts.margin) for piece in laid]
+        _verify(name, laid, placed, across, opts, stock)
+    except LayoutError:
+        if not opts.cache:
+            raise
+        # a kept marker that fails the check (edited, or from a broken run): searched anew, and kept again
+        placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline, refresh=True)
+        laid = tuple(piece.moved(Motion(*placements[i])) for i, piece in enumerate(every))
+        placed = [_outline(piece, opts.margin) for piece in laid]
+        _verify(name, laid, placed, across, opts, stock)
     seconds = time.perf_counter() - start
-    laid = tuple(piece.moved(Motion(*placements[i])) for i, piece in enumerate(every))
-    placed = [_outline(piece, opts.margin) for piece in laid]
-    _verify(name, laid, placed, across, opts, stock)
     area_pieces = float(sum(p.area for p in placed))
     if sheets:
         length = opts.sheet[0] * len(sheets)
@@ -302,6 +335,30 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
     sources = tuple(item for item in items if not isinstance(item, Piece))
     return Layout(name, laid, rects, float(across), float(length), float(used), area_pieces, tuple(sheets), seconds,
                   opts, sources)
+
+
+def check_piece_count(name: str, counts, opts: NestOptions) -> int:
+    """The number of pieces a nest of ``counts`` (per piece, copies included) takes, mirror images counted;
+    InputError past :data:`MAX_PIECES` (before any work: the command line checks it once the part is read)."""
+    total = int(sum(counts)) * (2 if opts.mirror else 1)
+    if total > MAX_PIECES:
+        raise InputError(f"{name}: {total} pieces to nest, over the limit of {MAX_PIECES} in one nest (sparrow's "
+                         f"set-up alone grows with them); nest fewer copies at a time")
+    return total
+
+
+def _left(deadline: float) -> int:
+    """Whole seconds left to ``deadline`` (time.monotonic), at least 1 (sparrow's least budget)."""
+    return max(1, int(deadline - time.monotonic()))
+
+
+def _placed(shapes, pieces, across, opts, name, deadline, *, refresh=False):
+    """``(placements, sheets, stock)``: sparrow's placements on the roll, or sheet after sheet."""
+    if opts.sheet is None:
+        placements = _solve(shapes, list(range(len(shapes))), across, opts, name, seconds=_left(deadline),
+                            refresh=refresh)
+        return placements, (), [(0.0, 0.0, across, None)]
+    return _fill_sheets(shapes, pieces, opts, name, deadline, refresh)
 
 
 def _outline(piece: Piece, margin: float):
@@ -344,8 +401,9 @@ def _tolerance(across: float) -> float:
     return 1e-6 * max(float(across), 1.0)
 
 
-def _solve(shapes, which, across, opts, name) -> dict:
-    """Sparrow on the pieces ``which``: ``{piece: (angle rad, dx, dy)}`` on a roll ``across`` wide."""
+def _solve(shapes, which, across, opts, name, *, seconds: int | None = None, refresh: bool = False) -> dict:
+    """Sparrow on the pieces ``which``: ``{piece: (angle rad, dx, dy)}`` on a roll ``across`` wide, searching
+    ``seconds`` (at most ``opts.time_limit``, the marker's key); ``refresh`` searches anew over a kept marker."""
     points = [_item_points(shapes[i]) for i in which]
     # sparrow keeps every item the separation away from the strip's edges too, and each item it sees is
     # the outline grown by SIMPLIFY: a strip wider by both on either side, and everything moved back by
@@ -357,9 +415,9 @@ def _solve(shapes, which, across, opts, name) -> dict:
     task = {"items": [np.round(p, 9).tolist() for p in points], "strip": float(across) + 2 * edge + slack,
             "orientations": _ANGLES[opts.rotations], "gap": float(opts.gap), "time": int(opts.time_limit),
             "seed": int(opts.seed)}
-    placed = _remembered(task) if opts.cache else None
+    placed = _remembered(task) if opts.cache and not refresh else None
     if placed is None:
-        placed = _sparrow(task, name)
+        placed = _sparrow(task, name, seconds=min(int(opts.time_limit), seconds or int(opts.time_limit)))
         if opts.cache:
             _remember(task, placed)
     out = {}
@@ -371,27 +429,61 @@ def _solve(shapes, which, across, opts, name) -> dict:
     return out
 
 
-def _sparrow(task: dict, name: str) -> list:
-    """``[(rotation deg, tx, ty)]`` per item: sparrow's answer to ``task``; LayoutError (naming ``name``) when
-    sparrow gives up."""
-    import spyrrow
+CHILD = Path(__file__).with_name("sparrow_child.py")
+"""The script sparrow runs in (:mod:`patterns.sparrow_child`)."""
 
-    items = [spyrrow.Item(str(k), [tuple(p) for p in pts], demand=1, allowed_orientations=task["orientations"])
-             for k, pts in enumerate(task["items"])]
-    instance = spyrrow.StripPackingInstance("patterns", strip_height=task["strip"], items=items)
-    config = spyrrow.StripPackingConfig(early_termination=True, total_computation_time=task["time"],
-                                        min_items_separation=task["gap"] if task["gap"] > 0 else None,
-                                        seed=task["seed"], num_workers=1)
+
+def _python() -> str:
+    """A Python to run :data:`CHILD` with: this one, or inside FreeCAD (whose executable is FreeCAD's) the
+    system's Python of the same version."""
+    if Path(sys.executable).name.startswith("python"):
+        return sys.executable
+    found = shutil.which(f"python{sys.version_info.major}.{sys.version_info.minor}") or shutil.which("python3")
+    if found is None:
+        raise LayoutError(f"no python{sys.version_info.major}.{sys.version_info.minor} on PATH to run sparrow in")
+    return found
+
+
+def _sparrow(task: dict, name: str, *, seconds: int | None = None) -> list:
+    """``[(rotation deg, tx, ty)]`` per item: sparrow's answer to ``task``, searched ``seconds`` (default the
+    task's time) in a process of its own, stopped past the search and its set-up
+    (:data:`SETUP_GRACE`), and on any signal this process gets; LayoutError (naming ``name``) when sparrow gives
+    up, panics (its message in one line, its backtrace kept off the console) or overruns."""
+    import importlib.util
+
+    seconds = int(task["time"] if seconds is None else seconds)
+    spec = importlib.util.find_spec("spyrrow")
+    if spec is None or spec.origin is None:
+        raise LayoutError(f"{name}: sparrow (the spyrrow package) is not installed")
+    where = str(Path(spec.origin).parent.parent)
+    env = dict(os.environ, RUST_BACKTRACE="0",
+               PYTHONPATH=os.pathsep.join(p for p in (where, os.environ.get("PYTHONPATH")) if p))
+    limit = seconds + SETUP_GRACE + SETUP_PER_PIECE * len(task["items"])
+    proc = subprocess.Popen([_python(), "-P", str(CHILD)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, env=env, start_new_session=True)  # Ctrl-C reaches us alone
     try:
-        solution = instance.solve(config)
-    except BaseException as exc:  # a panic in sparrow reaches Python as pyo3's PanicException, a BaseException
-        if isinstance(exc, (KeyboardInterrupt, SystemExit)):
-            raise
-        raise LayoutError(f"{name}: sparrow could not nest the pieces ({exc})") from None
-    placed = [None] * len(items)
-    for item in solution.placed_items:
-        placed[int(item.id)] = (float(item.rotation), *map(float, item.translation))
-    return placed
+        out, err = proc.communicate(json.dumps({**task, "time": seconds}).encode(), timeout=limit)
+    except subprocess.TimeoutExpired:
+        raise LayoutError(f"{name}: sparrow did not end within {limit:.0f} s (a {seconds} s search and its set-up "
+                          f"for {len(task['items'])} pieces): stopped; nest fewer pieces at a time") from None
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    try:
+        answer = json.loads(out)
+    except ValueError:
+        said = [line for line in err.decode(errors="replace").splitlines() if line.strip()]
+        why = (f"killed by signal {-proc.returncode}" if proc.returncode < 0
+               else said[-1].strip()[:300] if said else f"exit {proc.returncode}")
+        raise LayoutError(f"{name}: sparrow stopped ({why})") from None
+    if "error" in answer:
+        raise LayoutError(f"{name}: sparrow could not nest the pieces ({answer['error'][:300]})")
+    placed = answer["placed"]
+    if len(placed) != len(task["items"]) or any(p is None for p in placed):
+        raise LayoutError(f"{name}: sparrow placed {sum(p is not None for p in placed)} of {len(task['items'])} "
+                          f"pieces")
+    return [tuple(p) for p in placed]
 
 
 def cache_folder() -> Path:
@@ -409,11 +501,19 @@ def _key(task: dict) -> str:
 
 
 def _remembered(task: dict):
+    """The kept marker of ``task``, or None: none kept, or one that is not a marker of it (cut short,
+    edited: a count, a number that is not finite, a turn not allowed), which the search then replaces."""
     try:
         data = json.loads((cache_folder() / f"{_key(task)}.json").read_text())
-        return [tuple(map(float, row)) for row in data] if len(data) == len(task["items"]) else None
+        rows = [tuple(map(float, row)) for row in data]
     except (OSError, ValueError, TypeError):
         return None
+    if len(rows) != len(task["items"]) or any(len(r) != 3 or not all(map(math.isfinite, r)) for r in rows):
+        return None
+    turns = task["orientations"]
+    if turns is not None and any(min(abs((r[0] - a + 180) % 360 - 180) for a in turns) > 1e-3 for r in rows):
+        return None
+    return rows
 
 
 def _remember(task: dict, placed: list) -> None:
@@ -433,29 +533,37 @@ def _ends(shapes, found) -> dict:
             for i, (angle, dx, dy) in found.items()}
 
 
-def _fill_sheets(shapes, pieces, opts, name):
+FILL = 0.75
+"""The share of a sheet pieces are expected to take, for sharing the nest's time among the sheets to come."""
+
+
+def _fill_sheets(shapes, pieces, opts, name, deadline, refresh=False):
     """Sheet after sheet: the pieces nested on a strip as wide as a sheet, those lying wholly within the
     sheet's length kept on it; then each piece left over, largest first, tried on that sheet too (a short
     search of the sheet's pieces and it, kept if all fit), until the sheet's time is spent; the rest go on
-    to the next sheet."""
+    to the next sheet.  The time left to ``deadline`` is shared among the sheets the pieces left are
+    expected to fill (at :data:`FILL`); each sheet gets at least a second a search."""
     length, width = opts.sheet
     left = list(range(len(shapes)))
     placements, sheets, stock = {}, [], []
     trial = replace(opts, time_limit=max(1, opts.time_limit // 5))
     while left:
         start = time.monotonic()
-        found = _solve(shapes, left, width, opts, name)
+        expected = max(1, math.ceil(sum(shapes[i].area for i in left) / (FILL * length * width)))
+        share = max(1.0, (deadline - start) / expected)
+        found = _solve(shapes, left, width, opts, name, seconds=max(1, int(share / 2)), refresh=refresh)
         ends = _ends(shapes, found)
         on_sheet = [i for i in left if ends[i] <= length + 1e-9]
         if not on_sheet:  # the nearest piece alone, from the start of the sheet
             i = min(left, key=lambda j: found[j][2])
-            found = _solve(shapes, [i], width, trial, name)
+            found = _solve(shapes, [i], width, trial, name, seconds=1, refresh=refresh)
             on_sheet = [i]
         found = {i: found[i] for i in on_sheet}
         for i in sorted((j for j in left if j not in on_sheet), key=lambda j: -shapes[j].area):
-            if time.monotonic() - start > 2 * opts.time_limit:
+            if time.monotonic() - start + 1 > share:
                 break
-            attempt = _solve(shapes, on_sheet + [i], width, trial, name)
+            attempt = _solve(shapes, on_sheet + [i], width, trial, name, seconds=max(1, int(share / 10)),
+                             refresh=refresh)
             if max(_ends(shapes, attempt).values()) <= length + 1e-9:
                 on_sheet.append(i)
                 found = attempt

@@ -15,6 +15,7 @@
 
 from __future__ import annotations
 
+import math
 import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields, is_dataclass, replace
@@ -75,7 +76,13 @@ def _describe(low, high, low_open, high_open, integer) -> str:
     article = "an" if integer else "a"
     if low == 0 and low_open and high == LARGEST_LENGTH:
         return f"a positive {kind} {'<' if high_open else '<='} {high:g}"
+    if integer:  # an open end of integers is the next integer in: "between 1 and 100000", never "between 0" for > 0
+        low = None if low is None else (math.floor(low) + 1 if low_open else math.ceil(low))
+        high = None if high is None else (math.ceil(high) - 1 if high_open else math.floor(high))
+        low_open = high_open = False
     if low is not None and high is not None:
+        if low_open or high_open:
+            return f"{article} {kind} {'>' if low_open else '>='} {low:g} and {'<' if high_open else '<='} {high:g}"
         return f"{article} {kind} between {low:g} and {high:g}"
     if low == 0 and low_open:
         return f"a positive {kind}"

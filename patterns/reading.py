@@ -147,9 +147,15 @@ def check_source(path, suffixes=None) -> Path:
     if path.is_dir():
         raise InputError(f"{os.fsdecode(path)}: is a folder; give a CAD or mesh file")
     suffixes = suffixes or CAD_SUFFIXES + MESH_SUFFIXES
-    if path.suffix.lower() not in suffixes:
-        raise InputError(f"{os.fsdecode(path)}: unknown file type {path.suffix.lower() or '(none)'!r}; expected a "
-                         f"CAD file ({', '.join(CAD_SUFFIXES)}) or a mesh file ({', '.join(MESH_SUFFIXES)})")
+    suffix = path.suffix.lower()
+    if suffix not in suffixes:
+        cad = [s for s in CAD_SUFFIXES if s in suffixes]
+        mesh = [s for s in MESH_SUFFIXES if s in suffixes]
+        wanted = " or ".join([f"a CAD file ({', '.join(cad)})"] * bool(cad) + [f"a mesh file ({', '.join(mesh)})"] * bool(mesh))
+        if suffix in MESH_SUFFIXES and not mesh:  # unfold: a mesh is a part, but not a bent sheet
+            raise InputError(f"{os.fsdecode(path)}: is a mesh; unfolding takes {wanted} (a mesh has no exact bends: "
+                             f"flatten it instead)")
+        raise InputError(f"{os.fsdecode(path)}: unknown file type {suffix or '(none)'!r}; expected {wanted}")
     kind = "CAD" if path.suffix.lower() in CAD_SUFFIXES else "mesh"
     return _existing_file(path, suffixes, kind)[0]
 

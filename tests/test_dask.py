@@ -321,3 +321,94 @@ def test_a_file_past_its_timeout_is_given_up_on_dask(client_folder, cluster, cap
         assert (client_folder / "out" / f"{stem}.dxf").exists()
     assert not (client_folder / "out" / "slow.dxf").exists()
     assert code == 2
+
+
+# --------------------------------------------------------------------------- #
+# Issue 33: every network peer has a deadline; every way a cluster dies ends in the table, exit 2
+# --------------------------------------------------------------------------- #
+
+
+def test_a_port_that_accepts_and_never_answers_is_one_line(client_folder):
+    """A port that takes the connection and says nothing (never ended, killed at 300 s): refused in one line
+    within seconds, nothing written."""
+    import socket
+    import threading
+
+    server = socket.create_server(("127.0.0.1", 0))
+    held = []
+    stop = threading.Event()
+
+    def accept():
+        server.settimeout(0.2)
+        while not stop.is_set():
+            try:
+                held.append(server.accept()[0])  # and never a word
+            except OSError:
+                pass
+
+    thread = threading.Thread(target=accept)
+    thread.start()
+    try:  # in a process of its own, given 60 s: it never ended before
+        proc = subprocess.run([str(Path(PYTHON).with_name("patterns")), "batch", "parts", "-o", "out", "--scheduler",
+                               f"127.0.0.1:{server.getsockname()[1]}"], cwd=client_folder, capture_output=True,
+                              text=True, timeout=60, check=False)
+        code, err = proc.returncode, proc.stderr
+    finally:
+        stop.set()
+        thread.join()
+        for conn in held:
+            conn.close()
+        server.close()
+    assert code == 2 and err.strip().count("\n") == 0, err
+    assert "that port accepts connections but says nothing in 3 s: not a Dask scheduler" in err
+    assert not (client_folder / "out").exists()
+
+
+def _slow_parts(client_folder, n=3):
+    """Parts that take seconds each (dishes of 300,000 faces), so that the cluster can die mid-run."""
+    v, f = surfaces.paraboloid_dish(n_faces=300_000)
+    for k in range(n):
+        trimesh.Trimesh(v * (1 + 0.01 * k), f, process=False).export(client_folder / "parts" / f"slow{k}.obj")
+
+
+def _when_running(cluster, act):
+    """A thread that calls ``act()`` once the first file has run for a second on the cluster."""
+    import threading
+
+    def watch():
+        with distributed.Client(json.loads(cluster.file.read_text())["address"], timeout="10s") as client:
+            end = time.monotonic() + 120
+            while time.monotonic() < end:
+                if any(client.processing().values()) and sum(map(len, client.call_stack().values())):
+                    time.sleep(1.0)
+                    act()
+                    return
+                time.sleep(0.1)
+
+    thread = threading.Thread(target=watch)
+    thread.start()
+    return thread
+
+
+@pytest.mark.parametrize("what", ["workers", "scheduler"])
+def test_a_cluster_that_dies_mid_run_ends_in_the_table(client_folder, cluster, capfd, what):
+    """Every worker killed (SIGKILL, nanny and all), or the scheduler: a raw distributed traceback before
+    (TimeoutError: No valid workers found; OSError: Timed out trying to connect).  Now: the table, every file
+    a row (those not done lost, saying why), exit 2, within --wait seconds of the loss."""
+    _slow_parts(client_folder)
+    address = cluster.scheduler()
+    worker = cluster.worker(n=1)
+    cluster.wait_for(1)
+    target = worker if what == "workers" else cluster.procs[0]
+    thread = _when_running(cluster, lambda: os.killpg(target.pid, signal.SIGKILL))
+    start = time.monotonic()
+    code, out, err = _batch(["batch", "parts", "-o", "out", "--scheduler", address, "--wait", "3"], client_folder,
+                            capfd)
+    thread.join()
+    assert time.monotonic() - start < 90
+    assert code == 2 and "Traceback" not in out + err, out + err
+    rows = {line.split()[0]: line for line in out.splitlines()[1:10] if line.split()}
+    assert set(rows) >= {"slow0.obj", "slow1.obj", "slow2.obj", "cup.step", "broken.step"}, out
+    lost = [r for r in rows.values() if " lost" in r]
+    assert lost and all("went away" in r or "died" in r for r in lost), out
+    assert "batch: 9 files:" in out

@@ -286,13 +286,13 @@ def test_a_sheet_out_of_bounds_is_named(sheet, words):
 
 
 @pytest.mark.parametrize(("value", "words"), [
-    ({"face0": 0}, "quantities['face0'] must be an integer between 1 and 10000, got 0"),
-    ({"face0": 10001}, "got 10001"), ({"face0": 2.5}, "got 2.5"), ({"face0": True}, "got True"),
+    ({"face0": 0}, "quantities['face0'] must be an integer between 1 and 2000, got 0"),
+    ({"face0": 2001}, "got 2001"), ({"face0": 2.5}, "got 2.5"), ({"face0": True}, "got True"),
     (5, "quantities must map panel names to counts, e.g. {'sleeve': 2}")])
 def test_quantities_are_whole_counts_within_bounds(value, words):
     with pytest.raises(InputError, match=re.escape(words)):
         NestOptions(width=100.0, quantities=value)
-    assert NestOptions(width=100.0, quantities={"a": 1, 7: 10000}).quantities == {"a": 1, "7": 10000}
+    assert NestOptions(width=100.0, quantities={"a": 1, 7: 2000}).quantities == {"a": 1, "7": 2000}
 
 
 @pytest.mark.parametrize("value", [(100.0,), "ab", (1, 2, 3), {"length": 100.0}])
@@ -319,18 +319,24 @@ def test_every_input_of_a_search_is_in_its_marker_key():
 
 def test_the_cache_folder_is_made_and_a_broken_marker_searched_anew(plates, tmp_path, monkeypatch):
     """The cache folder is made (parents too) at the first marker kept; a kept file that is not a marker
-    (cut short, edited, another version's) is never used: the search runs again and keeps a good one."""
+    (cut short, edited, another version's, NaN, a turn not allowed) or a marker that fails the check is never
+    used: the search runs again and keeps a good one."""
     from patterns.nesting import cache_folder
 
     monkeypatch.setenv("PATTERNS_CACHE", str(tmp_path / "deep" / "er" / "markers"))
     first = patterns.layout(plates, width=300.0, seed=5, time_limit=1)
     (kept,) = cache_folder().iterdir()
-    for broken in ("[[0.0, 1.0", "[]", '{"a": 1}', "[[0, 1, 2]]"):
+    n = len(plates.panels)
+    poisoned = [json.dumps([[float("nan"), 0.0, 0.0]] * n),  # NaN (issue 33: every later run failed)
+                json.dumps([[45.0, 0.0, 0.0]] * n),  # a turn the grain does not allow
+                json.dumps([[0.0, 0.0, 0.0]] * n)]  # well formed, every piece on one spot: fails the shapely check
+    for broken in ("[[0.0, 1.0", "[]", '{"a": 1}', "[[0, 1, 2]]", *poisoned):
         kept.write_text(broken)
         again = patterns.layout(plates, width=300.0, seed=5, time_limit=1)
         assert again.seconds >= 0.5  # searched anew
         assert _disjoint(_outlines(again), 10.0) and len(again.pieces) == len(plates.panels)
         assert len(json.loads(kept.read_text())) == len(plates.panels)  # and the good marker kept again
+        assert kept.read_text() != broken and all(np.isfinite(json.loads(kept.read_text())).all(axis=1))
     assert first.length > 0
 
 

@@ -26,8 +26,13 @@ def test_bounds_and_messages():
     assert check_number(0.0, "tolerance", low=0) == 0.0
     with pytest.raises(InputError, match="part: max_strain must be a positive number, got 0"):
         check_number(0, "max_strain", low=0, low_open=True, name="part")
-    with pytest.raises(InputError, match="between 0 and 1"):
+    with pytest.raises(InputError, match="min_stretch must be a number > 0 and < 1, got 1.0"):
         check_number(1.0, "min_stretch", low=0, high=1, low_open=True, high_open=True)
+    # an open end of integers names the first integer in (issue 33: "between 0 and 100000, got 0")
+    with pytest.raises(InputError, match=r"^max_iterations must be an integer between 1 and 100000, got 0$"):
+        check_number(0, "max_iterations", low=0, high=100_000, low_open=True, integer=True)
+    with pytest.raises(InputError, match=r"^n must be an integer between 0 and 9, got 10$"):
+        check_number(10, "n", low=-0.5, high=10, high_open=True, integer=True)
     with pytest.raises(InputError, match="an integer >= 0"):
         check_number(2.5, "max_darts", low=0, integer=True)
 
@@ -161,6 +166,7 @@ def test_a_flag_makes_the_record_the_api_makes(argv, key, name, value):
     ("--k-factor", "1.5", "k_factor must be a number between 0 and 1, got 1.5"),
     ("--text-height", "inf", "text_height must be a positive number <= 1e+07, got inf"),
     ("--max-strain", "0", "max_strain must be a positive number, got 0"),
+    ("--max-iterations", "0", "max_iterations must be an integer between 1 and 100000, got 0"),
     ("--chord-tolerance", "nan", "chord_tolerance must be a positive number <= 1e+07, got nan"),
 ])
 def test_a_bad_flag_fails_in_one_line_before_loading(tmp_path, capsys, flag, text, message):

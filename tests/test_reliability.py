@@ -773,3 +773,234 @@ def test_picture_resolutions_are_bounded(here, dpi):
     with pytest.raises(patterns.InputError, match="dpi must be a number between"):
         patterns.preview_dxf(here / "d.dxf", here / "p.png", dpi=dpi)
     assert set(snapshot(here)) == set(before) | {b"d.dxf"}
+
+
+# --------------------------------------------------------------------------- #
+# Issue 33: the bend table is an input, and a bounded, sane one
+# --------------------------------------------------------------------------- #
+
+TABLE = "thickness,radius,angle,deduction\n2,3,90,3.5\n"
+
+
+@pytest.fixture
+def bent(tmp_path):
+    """A folder holding the bracket (2 mm, R3, one 90 degree bend) and a good bend table."""
+    shutil.copy(SAMPLES / "bracket.step", tmp_path / "part.step")
+    (tmp_path / "table.csv").write_text(TABLE)
+    return tmp_path
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (["-o", "table.dxf", "--bend-table", "table.dxf"], "table.dxf: is an input of this run"),
+    (["-o", "o.dxf", "--report", "table.json", "--bend-table", "table.json"], "table.json: is an input of this run"),
+    (["-o", "o.dxf", "--preview", "table.png", "--bend-table", "table.png"], "table.png: is an input of this run"),
+])
+def test_no_output_replaces_the_bend_table(bent, capfd, argv, words):
+    for name in ("table.dxf", "table.json", "table.png"):
+        (bent / name).write_text(TABLE)
+    refused(["unfold", "part.step", *argv], bent, capfd, words)
+
+
+def test_a_deduction_that_puts_the_neutral_layer_outside_the_sheet_is_refused(bent, capfd):
+    """-1e6 mm would make a kilometre blank; 2 (r + t) tan 45 - (pi / 2)(r + K t) is 2.146-5.288 mm for K 0-1."""
+    (bent / "table.csv").write_text("thickness,radius,angle,deduction\n2,3,90,-1e6\n")
+    line = refused(["unfold", "part.step", "-o", "o.dxf", "--bend-table", "table.csv"], bent, capfd,
+                   "table.csv, line 2: deduction -1e+06 mm")
+    assert "K-factor 0 to 1 gives 2.146 to 5.288 mm" in line
+    for ded, ok in [(2 * 5 - np.pi / 2 * (3 + 1.5 * 2) - 0.06, False), (2 * 5 - np.pi / 2 * (3 + 1.5 * 2) + 0.04, True),
+                    (2 * 5 - np.pi / 2 * (3 - 0.5 * 2) + 0.06, False), (2 * 5 - np.pi / 2 * (3 - 0.5 * 2) - 0.04, True)]:
+        (bent / "table.csv").write_text(f"thickness,radius,angle,deduction\n2,3,90,{ded!r}\n")
+        if ok:
+            blank = patterns.unfold(bent / "part.step", bend_table=bent / "table.csv")
+            assert blank.bends[0].allowance == pytest.approx(2 * 5 - ded, abs=1e-9)
+        else:
+            with pytest.raises(patterns.InputError, match="neutral layer outside the sheet"):
+                patterns.read_bend_table(bent / "table.csv")
+
+
+@pytest.mark.parametrize(("text", "words"), [
+    ("thickness,radius,angle,deduction\n2,3,90," + "1" * 200_000 + "\n", "table.csv, line 2: not a CSV bend table"),
+    ("thickness,radius,angle,deduction\n2,3,180,3\n", "line 2: the bend angle must be between 0 and 180 degrees"),
+    ("thickness,radius,angle,deduction\n2,3,90,nan\n", "line 2: every value must be a finite number"),
+    ("thickness,radius,angle,deduction\n", "the bend table has no rows"),
+    ("thickness,radius,angle,deduction\n" + "2,3,90,3.5\n" * 100_000, "table.csv: 1100033 bytes; a bend table is at most 1 MB"),
+])
+def test_an_absurd_bend_table_is_one_line(bent, capfd, text, words):
+    (bent / "table.csv").write_text(text)
+    refused(["unfold", "part.step", "-o", "o.dxf", "--bend-table", "table.csv"], bent, capfd, words)
+
+
+@pytest.mark.parametrize(("make", "words"), [
+    (lambda p: os.mkfifo(p), "t.csv: is not a regular file (a device, pipe or socket)"),
+    (lambda p: p.mkdir(), "t.csv: is a folder, not a bend table"),
+    (lambda p: os.symlink("/dev/zero", p), "t.csv: is not a regular file"),
+])
+def test_a_bend_table_that_is_not_a_file_is_named_as_such(bent, capfd, make, words):
+    make(bent / "t.csv")
+    refused(["unfold", "part.step", "-o", "o.dxf", "--bend-table", "t.csv"], bent, capfd, words)
+
+
+def test_unfold_of_a_mesh_says_a_mesh_has_no_bends(bent, capfd):
+    shutil.copy(SAMPLES / "dish.obj", bent / "dish.obj")
+    line = refused(["unfold", "dish.obj", "-o", "o.dxf"], bent, capfd,
+                   "dish.obj: is a mesh; unfolding takes a CAD file (.step, .stp, .brep, .brp, .iges, .igs)")
+    assert ".obj" not in line.split("takes", 1)[1]
+    with pytest.raises(patterns.InputError, match="dish.obj: is a mesh; unfolding takes a CAD file"):
+        patterns.unfold(bent / "dish.obj")
+
+
+def helix_strip(n: int = 300, turns: float = 3.0) -> tuple:
+    """A strip one triangle wide wound ``turns`` times on a helix (radii 50 and 70 mm, pitch 30 mm): every
+    vertex on its boundary, no interior vertex.  ``(vertices (2n, 3), faces (2n - 2, 3))``."""
+    t = np.linspace(0, turns * 2 * np.pi, n)
+    rows = [np.column_stack([r * np.cos(t), r * np.sin(t), 30 * t / (2 * np.pi)]) for r in (50.0, 70.0)]
+    i = np.arange(n - 1)
+    faces = np.concatenate([np.column_stack([i, i + 1, n + i]), np.column_stack([i + 1, n + i + 1, n + i])])
+    return np.concatenate(rows), faces
+
+
+def _singular_values(v3, f, uv):
+    """Per triangle, the 3D->2D map's smallest and largest singular values, from the positions alone."""
+    e3 = np.stack([v3[f[:, 1]] - v3[f[:, 0]], v3[f[:, 2]] - v3[f[:, 0]]], axis=1)
+    x = e3[:, 0] / np.linalg.norm(e3[:, 0], axis=1)[:, None]
+    y = e3[:, 1] - (e3[:, 1] * x).sum(1)[:, None] * x
+    y /= np.linalg.norm(y, axis=1)[:, None]
+    local = np.stack([np.stack([(e3[:, k] * x).sum(1), (e3[:, k] * y).sum(1)], 1) for k in (0, 1)], 2)  # (m, 2, 2)
+    flat = np.stack([uv[f[:, 1]] - uv[f[:, 0]], uv[f[:, 2]] - uv[f[:, 0]]], axis=2)
+    s = np.linalg.svd(flat @ np.linalg.inv(local), compute_uv=False)
+    return s[:, -1], s[:, 0]
+
+
+@pytest.mark.parametrize("argv", [[], ["--min-stretch", "0.3"]])
+def test_a_strip_with_every_vertex_on_its_boundary_flattens(tmp_path, capfd, argv):
+    """Issue 33 (a regression): no interior vertex left the Tutte start an empty system.  The pattern is one
+    closed outline read back from the DXF, one-to-one, within 5 % of the mesh's area (the usable-pattern check)."""
+    import ezdxf
+    import shapely
+
+    v, f = helix_strip()
+    trimesh.Trimesh(v, f, process=False).export(tmp_path / "helix.obj")
+    code, out, err = run(["flatten", "helix.obj", "-o", "helix.dxf", *argv], tmp_path, capfd)
+    assert code == 0 and "helix.obj: ok" in out, err
+    cut = [e for e in ezdxf.readfile(tmp_path / "helix.dxf").modelspace().query("LWPOLYLINE") if e.closed]
+    assert len(cut) == 1
+    polygon = shapely.Polygon([p[:2] for p in cut[0].get_points()])
+    area3d = trimesh.Trimesh(v, f, process=False).area
+    assert polygon.is_valid and abs(polygon.area / area3d - 1) < 0.05
+    if argv:
+        pattern = patterns.flatten(patterns.load(tmp_path / "helix.obj"), min_stretch=0.3)
+        panel = pattern.panels[0]
+        low, _ = _singular_values(panel.vertices, panel.faces, panel.uv)
+        assert low.min() >= 0.3 - 1e-6
+
+
+# --------------------------------------------------------------------------- #
+# Issue 33: the nest -- signals stop it, its geometry is checked first, sparrow's panics are one line
+# --------------------------------------------------------------------------- #
+
+
+def _child_commands(pid: int) -> list:
+    """The command lines of the processes whose parent is ``pid`` (from /proc)."""
+    out = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            with contextlib.suppress(OSError):
+                if int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1]) == pid:
+                    out.append((int(entry.name), (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()))
+    return out
+
+
+@pytest.mark.parametrize(("sig", "code", "word"), [(signal.SIGINT, 130, "interrupted"),
+                                                   (signal.SIGTERM, 143, "terminated")])
+def test_a_signal_stops_the_nest_and_writes_nothing(here, sig, code, word):
+    """Issue 33: sparrow searching (its process running, 120 s to go), Ctrl-C or SIGTERM: exit 130 or 143 at
+    once, one line, nothing written or changed (out.dxf was there before), sparrow's process gone."""
+    (here / "out.dxf").write_text("the user's file\n")
+    before = snapshot(here)
+    proc = subprocess.Popen([str(EXE), "flatten", "cup.step", "-o", "out.dxf", "--report", "out.json",
+                             "--roll-width", "1500", "--copies", "5", "--nest-time", "120", "--no-nest-cache"],
+                            cwd=here, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    end = time.monotonic() + 120
+    while time.monotonic() < end and not any("sparrow_child" in c for _, c in _child_commands(proc.pid)):
+        time.sleep(0.05)
+    sparrow = [p for p, c in _child_commands(proc.pid) if "sparrow_child" in c]
+    assert sparrow, "sparrow was not searching"
+    time.sleep(1.0)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == code and err.strip() == f"patterns: {word}; nothing written", err
+    assert snapshot(here) == before
+    assert not Path(f"/proc/{sparrow[0]}").exists() or "Z" in Path(f"/proc/{sparrow[0]}/stat").read_text().split()[2]
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (["--roll-width", "1500", "--nest-gap", "1e6"], ("nest_gap 1e+06 mm (and margin 0 mm each side) is as wide as "
+                                                     "the 1500 mm roll")),
+    (["--sheet", "100x80", "--nest-gap", "50", "--margin", "15"], "is as wide as the 100 x 80 mm sheet"),
+    (["--roll-width", "1500", "--copies", "10000"], "copies must be an integer between 1 and 2000, got 10000"),
+    (["--roll-width", "1500", "--copies", "1000"], ("cup.step: 4000 pieces to nest, over the limit of 2000 in one "
+                                                    "nest")),
+    (["--roll-width", "1500", "--copies", "600", "--mirror"], "4800 pieces to nest"),
+])
+def test_a_nest_that_cannot_be_is_refused_before_flattening(here, capfd, argv, words):
+    """A gap as wide as the stock (sparrow panicked, 195 lines), or more pieces than a nest takes (10,000 copies
+    ran past 600 s): one line, before the part is flattened."""
+    before = snapshot(here)
+    code, out, err = run(["flatten", "cup.step", "-o", "o.dxf", *argv], here, capfd)
+    assert code == 2 and err.strip().splitlines() == [f"patterns: error: {err.split('error: ', 1)[1].strip()}"]
+    assert words in err and "flattened" not in out and snapshot(here) == before
+
+
+def test_a_panic_in_sparrow_is_one_line_and_its_backtrace_stays_away(capfd, monkeypatch):
+    """A panic (an item wider than its strip: layout() never sends one), with RUST_BACKTRACE=1 in the
+    user's environment: a LayoutError in one line, nothing on this process's stderr."""
+    from patterns.nesting import _sparrow
+
+    monkeypatch.setenv("RUST_BACKTRACE", "1")
+    task = {"items": [[[0.0, 0.0], [50.0, 0.0], [50.0, 200.0], [0.0, 200.0]]], "strip": 100.0,
+            "orientations": [0.0], "gap": 0.0, "time": 1, "seed": 0}
+    with pytest.raises(patterns.LayoutError) as caught:
+        _sparrow(task, "wide")
+    assert "\n" not in str(caught.value) and str(caught.value).startswith("wide: sparrow could not nest the pieces (")
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+
+
+def test_a_link_another_user_planted_in_a_shared_folder_is_not_written_through(tmp_path, capfd):
+    """Issue 33: ``shared/out.dxf``, in a sticky world-writable folder, a link by another user to a file only
+    root may write: refused as the kernel's protected_symlinks would (the links are resolved here, not by it);
+    the file is untouched.  One's own link there is written through, as any link is."""
+    if os.geteuid() != 0:
+        pytest.skip("making a link owned by another user takes root")
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o1777)
+    secret = tmp_path / "secret.conf"
+    secret.write_text("root's\n")
+    secret.chmod(0o600)
+    os.symlink(secret, shared / "out.dxf")
+    os.lchown(shared / "out.dxf", 65534, 65534)
+    shutil.copy(SAMPLES / "dish.obj", tmp_path / "dish.obj")
+    before = snapshot(tmp_path)
+    code, _, err = run(["flatten", "dish.obj", "-o", "shared/out.dxf"], tmp_path, capfd)
+    assert code == 2 and "shared/out.dxf: is a link another user (uid 65534) made in a shared folder" in err, err
+    assert snapshot(tmp_path) == before and secret.read_text() == "root's\n"
+    os.symlink(tmp_path / "mine.dxf", shared / "mine.dxf")  # root's own link: written through
+    code, _, _ = run(["flatten", "dish.obj", "-o", "shared/mine.dxf"], tmp_path, capfd)
+    assert code == 0 and (tmp_path / "mine.dxf").read_text().startswith("  0\nSECTION")
+
+
+def test_an_unreadable_home_is_not_a_traceback(here):
+    """Issue 33: ``sudo -u user`` without ``-H`` keeps a HOME the user cannot read; ezdxf's import read its
+    settings there and failed with a traceback.  Now the run works, says nothing more, and leaves nothing."""
+    home = here / "home"
+    home.mkdir()
+    home.chmod(0)
+    try:
+        proc = cmd(["flatten", "dish.obj", "-o", "d.dxf", "--preview", "d.png", "--roll-width", "1000"], here,
+                   prefix=no_dac_override(), env={**os.environ, "HOME": str(home), "XDG_CONFIG_HOME": "",
+                                                  "XDG_CACHE_HOME": "", "MPLCONFIGDIR": ""})
+    finally:
+        home.chmod(0o755)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert (here / "d.dxf").exists() and (here / "d.png").exists()

@@ -176,10 +176,10 @@ def test_k_factor_moves_the_length_by_angle_times_thickness():
 
 def test_bend_table_gives_the_bend_deduction(tmp_path):
     table = tmp_path / "bends.csv"
-    table.write_text("thickness,radius,angle,deduction\n1.5,2,60,1.0\n1.5,2,120,3.0\n2,2,90,9\n")
+    table.write_text("thickness,radius,angle,deduction\n1.5,2,60,1.3\n1.5,2,120,6.7\n2,2,90,3.5\n")
     blank = patterns.unfold(bent_strip(), bend_table=table)
-    # 90 degrees lies half-way between the rows of 60 and 120: BD 2.0.  Mold-line flanges: la + r + t, lb + r + t.
-    assert max(blank.size) == pytest.approx((60 + 2 + 1.5) + (40 + 2 + 1.5) - 2.0, abs=1e-9)
+    # 90 degrees lies half-way between the rows of 60 and 120: BD 4.0.  Mold-line flanges: la + r + t, lb + r + t.
+    assert max(blank.size) == pytest.approx((60 + 2 + 1.5) + (40 + 2 + 1.5) - 4.0, abs=1e-9)
     assert blank.k_factor is None
     with pytest.raises(patterns.InputError, match=r"bends.csv: no row for thickness 1.5 mm, inside radius 2 mm"):
         patterns.unfold(bent_strip(angle=150), bend_table=table)
@@ -197,6 +197,43 @@ def test_bend_table_gives_the_bend_deduction(tmp_path):
 def test_a_machined_block_is_not_a_sheet():
     block = bd.Box(100, 100, 20) - bd.Pos(0, 0, 5) * bd.Box(50, 50, 10)
     with pytest.raises(patterns.InputError, match="not a sheet"):
+        patterns.unfold(block)
+
+
+def corrugated(*, t=1.0, width=5.0, r=2.0, waves=4, flat=20.0, rise=15.0):
+    """A corrugated strip: a ``width`` x ``t`` rectangle swept along a filleted zig-zag centre line; its end
+    face (the whole profile, ``t`` thick) is larger than any one flat.  Returns (solid, centre line)."""
+    points, x = [(0.0, 0.0)], 0.0
+    for i in range(waves):
+        x += flat
+        points.append((x, (i % 2) * rise))
+        x += flat / 2
+        points.append((x, ((i + 1) % 2) * rise))
+    points.append((x + flat, (waves % 2) * rise))
+    with bd.BuildLine() as line:
+        bd.FilletPolyline(*points, radius=r + t / 2)
+    path = line.wire()
+    plane = bd.Plane(origin=path.position_at(0), x_dir=(0, 0, 1), z_dir=path.tangent_at(0))
+    return bd.sweep(plane * bd.Rectangle(width, t), path=path, transition=bd.Transition.RIGHT), path
+
+
+def test_a_corrugated_strip_whose_end_face_is_the_largest_unfolds_from_a_flat():
+    """Issue 33: the largest planar face is the end (8 % of the surface, not a skin): the next plane that starts
+    a sheet is the fixed face, and the blank is the centre line long (K 0.5: the neutral layer is the middle)."""
+    part, path = corrugated()
+    planes = sorted((f for f in part.faces() if f.geom_type == bd.GeomType.PLANE), key=lambda f: -f.area)
+    assert planes[0].area == pytest.approx(path.length * 1.0, rel=1e-9)  # the end face: the profile, 1 mm thick
+    blank = patterns.unfold(part, k_factor=0.5)
+    assert sorted(blank.size) == pytest.approx([5.0, path.length], abs=1e-6)
+    assert len(blank.bends) == 8 and blank.thickness == pytest.approx(1.0, abs=1e-9)
+    assert part.faces()[blank.fixed_face].geom_type == bd.GeomType.PLANE
+    assert part.faces()[blank.fixed_face].area < planes[0].area
+
+
+def test_a_block_is_refused_naming_the_face_option():
+    block = bd.Box(100, 100, 20) - bd.Pos(0, 0, 5) * bd.Box(50, 50, 10)
+    with pytest.raises(patterns.InputError, match=r"not a sheet.*no other planar face starts a sheet either "
+                                                  r"\(fixed_face=N, --fixed-face N"):
         patterns.unfold(block)
 
 

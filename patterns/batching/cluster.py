@@ -104,8 +104,18 @@ class DaskRunner:
             if on_start is not None and tries == 1:
                 on_start(printable(path.name))
 
-        for index in largest_first(files):  # Dask runs tasks in the order they were submitted
-            submit(index, 1)
+        def lost(index, why):
+            return index, {"file": files[index].name, "status": "lost", "reason": why}
+
+        order = largest_first(files)  # Dask runs tasks in the order they were submitted
+        for k, index in enumerate(order):
+            try:
+                submit(index, 1)
+            except Exception as exc:  # noqa: BLE001 - the cluster went while the files were being sent
+                for other in order[k:]:
+                    yield lost(other, f"not sent: the cluster went away ({_said(exc)})")
+                break
+        alone = _Vigil(self.client, self.opts.wait)
         while pending:
             with contextlib.suppress(Exception):  # none finished in that second, or one was lost: see below
                 wait(list(pending), timeout=1.0, return_when="FIRST_COMPLETED")
@@ -116,14 +126,27 @@ class DaskRunner:
                     row = future.result()
                 except Exception as exc:  # noqa: BLE001 - KilledWorker, a lost connection, ...
                     if tries < 2:
-                        submit(index, tries + 1)  # its worker died: once more
-                        future.release()
+                        try:
+                            submit(index, tries + 1)  # its worker died: once more
+                        except Exception as again:  # noqa: BLE001 - no worker left, no scheduler
+                            yield lost(index, f"its worker died and it could not be sent again ({_said(again)})")
+                        with contextlib.suppress(Exception):
+                            future.release()
                         continue
                     row = {"file": files[index].name, "status": "lost",
                            "reason": f"its worker died twice ({type(exc).__name__}: killed -- out of memory, or a "
                                      f"crash)"}
-                future.release()
+                with contextlib.suppress(Exception):
+                    future.release()
                 yield index, row
+            gone = alone.gone() if pending else None
+            if gone:  # no worker, or no scheduler, for --wait seconds: what is left will not run
+                for future in list(pending):
+                    index, _ = pending.pop(future)
+                    with contextlib.suppress(Exception):
+                        future.cancel()
+                    yield lost(index, gone)
+                return
             # executing now -- not merely sent to a worker, where it may wait behind another task
             running = {key for keys in self._executing(pending).values() for key in keys}
             now = time.monotonic()
@@ -152,6 +175,37 @@ class DaskRunner:
             self.client = None
 
 
+def _said(exc: BaseException) -> str:
+    """An exception in a row: its kind and first line."""
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
+
+
+class _Vigil:
+    """Whether the cluster is still there: the scheduler connected and at least one worker, checked each time
+    it is asked; gone when either has been missing for ``wait`` seconds."""
+
+    def __init__(self, client, wait: float):
+        self.client, self.wait = client, wait
+        self.since = None
+
+    def gone(self) -> str | None:
+        try:
+            connected = self.client.status == "running"
+            workers = len(self.client.scheduler_info().get("workers", {})) if connected else 0
+        except Exception:  # noqa: BLE001 - a client that lost its scheduler raises anything
+            connected, workers = False, 0
+        if connected and workers:
+            self.since = None
+            return None
+        now = time.monotonic()
+        self.since = self.since or now
+        if now - self.since < self.wait:
+            return None
+        what = "no worker" if connected else "no scheduler"
+        return f"not run: {what} for {self.wait:g} s (the cluster went away)"
+
+
 def _scheduler_address(text: str, timeout: float) -> str:
     """``tcp://host:port``, checked: parsed, the port reached, and not the dashboard's (InputError otherwise)."""
     import socket
@@ -176,15 +230,36 @@ def _scheduler_address(text: str, timeout: float) -> str:
         raise InputError(f"{text}: cannot reach the Dask scheduler (no answer in {timeout:g} s)") from None
     except OSError as exc:
         raise InputError(f"{text}: cannot reach the Dask scheduler ({exc.strerror or exc})") from None
-    try:  # a scheduler says nothing to this; a web server (the dashboard, on 8787) answers HTTP
-        sock.settimeout(1.0)
-        sock.sendall(b"GET / HTTP/1.0\r\n\r\n")
-        answer = sock.recv(5)
-    except OSError:
-        answer = b""
+    try:
+        said = _first_words(sock, timeout)
     finally:
         sock.close()
-    if answer.startswith(b"HTTP"):
-        raise InputError(f"{text}: that port answers HTTP: it is the Dask dashboard, not the scheduler (give the "
-                         f"scheduler's port, usually 8786)")
+    if b"compression" not in said:  # a Dask scheduler opens with its handshake (msgpack, naming "compression")
+        if said.startswith(b"HTTP"):
+            raise InputError(f"{text}: that port answers HTTP: it is the Dask dashboard, not the scheduler (give "
+                             f"the scheduler's port, usually 8786)")
+        if not said:
+            raise InputError(f"{text}: that port accepts connections but says nothing in {timeout:g} s: not a Dask "
+                             f"scheduler (a scheduler greets at once)")
+        raise InputError(f"{text}: that port is not a Dask scheduler (it said {said[:20]!r})")
     return f"tcp://{host}:{port}" if ":" not in host else f"tcp://[{host}]:{port}"
+
+
+def _first_words(sock, timeout: float) -> bytes:
+    """What a server says first: a Dask scheduler its handshake, at once; else (a web server, the dashboard,
+    waits to be asked) its answer to an HTTP request; ``b""`` when it says nothing within ``timeout``."""
+    try:
+        sock.settimeout(timeout)
+        said = sock.recv(256)
+        if said:
+            return said
+    except TimeoutError:
+        pass
+    except OSError:
+        return b""
+    try:
+        sock.settimeout(1.0)
+        sock.sendall(b"GET / HTTP/1.0\r\n\r\n")
+        return sock.recv(256)
+    except OSError:
+        return b""

@@ -193,6 +193,8 @@ def tutte_embedding(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity)
     rhs = -(lap[free][:, fixed] @ xy[fixed])
     points = np.concatenate([vertices, [vertices[loop].mean(axis=0) for loop in holes]]) if holes else vertices
     inner = np.flatnonzero(free)
+    if len(inner) == 0:  # every vertex on the outer loop (a strip one triangle wide): the circle is the embedding
+        return xy[:n]
     index = np.full(size, -1, dtype=np.int64)
     index[inner] = np.arange(len(inner))
     inner_edges = index[e[free[e[:, 0]] & free[e[:, 1]]]]

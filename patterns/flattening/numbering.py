@@ -46,6 +46,8 @@ def _spread(x: np.ndarray, d: int) -> np.ndarray:
 def _morton(points: np.ndarray) -> np.ndarray:
     """Morton (Z-order) codes ``(n,) uint64`` of 2D or 3D points over their bounding box."""
     d = points.shape[1]
+    if len(points) == 0:
+        return np.zeros(0, dtype=np.uint64)
     lo = points.min(axis=0)
     span = float(np.ptp(points, axis=0).max()) or 1.0
     top = 2 ** _BITS[d] - 1

@@ -28,7 +28,7 @@ from pathlib import Path
 from ..blank import Bend, Blank
 from ..errors import InputError
 from ..findings import Code, Finding, Severity
-from ..reading import read_cad
+from ..reading import CAD_SUFFIXES, check_source, read_cad
 from ..tessellate.topology import read_topology
 from .bends import curvatures, face_maps, group_bends
 from .contour import bend_line, cut_loops, overlaps
@@ -45,7 +45,7 @@ def _shape(source, name):
     from OCP.TopoDS import TopoDS_Shape
 
     if isinstance(source, (str, Path)):
-        return read_cad(source), name or Path(source).stem
+        return read_cad(check_source(source, CAD_SUFFIXES)), name or Path(source).stem
     wrapped = getattr(source, "wrapped", source)  # a build123d shape wraps its OCP one
     if not isinstance(wrapped, TopoDS_Shape):
         raise InputError(f"unfold takes a STEP/BREP/IGES path or a build123d/OCP shape, got {type(source).__name__}")

@@ -49,29 +49,43 @@ class Sheet:
 
 
 def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: str) -> Sheet:
-    """The sheet: its fixed face (the largest planar face unless given), thickness and skin."""
+    """The sheet: its fixed face, thickness and skin.
+
+    The fixed face is ``fixed_face`` when given, else the largest planar face
+    that starts a sheet: the first, by area, whose smooth region (the faces
+    reached across tangent edges) is nearly half the part's surface and that
+    has a parallel face behind it.  A corrugated strip's end face (the whole
+    profile, larger than any one flat) is passed over that way.
+    """
     largest = max(faces, key=lambda f: f.area)
     if largest.kind == "cylinder" and any(owners == (largest.index, largest.index) for owners in topology.edge_faces):
         raise InputError(f"{name}: a closed tube (face {largest.index} goes all the way round, with no seam): "
                          f"cut it along a line of its axis first")
-    planes = [f for f in faces if f.kind == "plane"]
+    planes = sorted((f for f in faces if f.kind == "plane"), key=lambda f: -f.area)
     if not planes:
         raise InputError(f"{name}: not a sheet-metal part: it has no planar face")
-    if fixed_face is None:
-        fixed = max(planes, key=lambda f: f.area).index
-    elif fixed_face >= len(faces) or faces[fixed_face].kind != "plane":
+    if fixed_face is not None and (fixed_face >= len(faces) or faces[fixed_face].kind != "plane"):
         raise InputError(f"{name}: fixed_face {fixed_face} is not a planar face of the part "
                          f"(it has faces 0..{len(faces) - 1})")
-    else:
-        fixed = fixed_face
-    thickness = _thickness(faces, fixed, name)
-    skin, neighbours = _skin(topology, faces, fixed, name)
-    share = sum(faces[i].area for i in skin) / sum(f.area for f in faces)
-    if share < SIDE:
-        raise InputError(f"{name}: not a sheet: face {fixed} and the faces joined to it smoothly are {share:.0%} of "
-                         f"the part's surface, one side of a sheet nearly half (a block, a thick plate, the end "
-                         f"of a tube)")
-    return Sheet(thickness, fixed, frozenset(skin), neighbours)
+    tangent = _tangent_edges(topology, faces)
+    neighbours = _neighbours(tangent, len(faces))
+    total = sum(f.area for f in faces)
+    first = None
+    for fixed in [fixed_face] if fixed_face is not None else [f.index for f in planes]:
+        skin = _skin(topology, tangent, neighbours, fixed, name)  # a sheet closed on itself: said at once
+        try:
+            share = sum(faces[i].area for i in skin) / total
+            if share < SIDE:
+                raise InputError(f"{name}: not a sheet: face {fixed} and the faces joined to it smoothly are "
+                                 f"{share:.0%} of the part's surface, one side of a sheet nearly half (a block, a "
+                                 f"thick plate, the end of a tube)")
+            return Sheet(_thickness(faces, fixed, name), fixed, frozenset(skin), neighbours)
+        except InputError as exc:
+            first = first or exc
+    if fixed_face is None and len(planes) > 1:
+        raise InputError(f"{first}; no other planar face starts a sheet either (fixed_face=N, --fixed-face N, "
+                         f"names the face to unfold from)") from None
+    raise first
 
 
 def _thickness(faces, fixed, name) -> float:
@@ -119,15 +133,19 @@ def _tangent_edges(topology: Topology, faces) -> dict:
     return out
 
 
-def _skin(topology: Topology, faces, fixed, name):
-    """The faces reached from ``fixed`` across tangent edges, and every face's tangent neighbours."""
-    tangent = _tangent_edges(topology, faces)
-    neighbours = [[] for _ in faces]
+def _neighbours(tangent: dict, n: int) -> tuple:
+    """Per face, ``((other face, shared edge), ...)`` across its tangent edges."""
+    neighbours = [[] for _ in range(n)]
     for e, pair in tangent.items():
         if pair is not None:
             a, b = pair
             neighbours[a].append((b, e))
             neighbours[b].append((a, e))
+    return tuple(tuple(x) for x in neighbours)
+
+
+def _skin(topology: Topology, tangent: dict, neighbours: tuple, fixed: int, name: str) -> set:
+    """The faces reached from ``fixed`` across tangent edges."""
     skin, stack = {fixed}, [fixed]
     while stack:
         i = stack.pop()
@@ -139,7 +157,7 @@ def _skin(topology: Topology, faces, fixed, name):
         if pair is None and topology.edge_faces[e][0] in skin:
             raise InputError(f"{name}: the sheet closes on itself around face {topology.edge_faces[e][0]} "
                              f"(a tube with no seam): cut it along a line first")
-    return skin, tuple(tuple(n) for n in neighbours)
+    return skin
 
 
 def check_volume(shape, sheet: Sheet, faces, curvature: dict, meshed: dict, name: str) -> None:

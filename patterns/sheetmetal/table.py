@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..files import check_input_file
 from ..options import Options, option
 
 __all__ = ["BendTable", "UnfoldOptions", "read_bend_table"]
@@ -51,39 +52,84 @@ class BendTable:
         return 2 * (radius + thickness) * np.tan(np.radians(angle) / 2) - deduction
 
 
+MAX_TABLE_BYTES = 1_000_000
+"""A bend table larger than this is refused unread (a shop's table is a few hundred rows)."""
+K_SLACK = 0.5
+"""How far outside the sheet (in thicknesses) a row's neutral layer may lie: a deduction whose implied
+K-factor is outside ``[-K_SLACK, 1 + K_SLACK]`` is refused as a typing error (real tables give 0.2-0.5)."""
+ROUNDING = 0.05
+"""mm a deduction may be off the K-factor range for its rounding (small angles give tiny deductions)."""
+
+
 def read_bend_table(path) -> BendTable:
     """Read a bend-deduction table (CSV with a header naming ``thickness, radius, angle, deduction``).
+
+    Every row is checked: a positive thickness and inside radius, an angle
+    between 0 and 180 degrees, and a deduction whose implied neutral layer lies
+    within half a thickness of the sheet (:data:`K_SLACK`), so that no
+    deduction can exceed the flanges it joins or make a blank kilometres long.
 
     Raises
     ------
     InputError
-        Missing file, missing column, or a value that is not a number, naming the file and line.
+        Missing file, a folder, pipe or device, a file over 1 MB, a missing
+        column, a value that is not a number, or a row out of range, naming the
+        file and line.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such bend table")
+    path = check_input_file(path, what="bend table (CSV)")
+    if path.stat().st_size > MAX_TABLE_BYTES:
+        raise InputError(f"{path}: {path.stat().st_size} bytes; a bend table is at most "
+                         f"{MAX_TABLE_BYTES // 1_000_000} MB (a few hundred rows)")
+    need = ("thickness", "radius", "angle", "deduction")
+    rows = []
     try:
         with open(path, newline="", encoding="utf-8") as fh:
             reader = csv.DictReader(fh)
-            need = ("thickness", "radius", "angle", "deduction")
             header = [h.strip().lower() for h in (reader.fieldnames or [])]
             missing = [n for n in need if n not in header]
             if missing:
                 raise InputError(f"{path}: a bend table needs the columns {', '.join(need)}; "
                                  f"missing {', '.join(missing)}")
-            rows = []
             for line, row in enumerate(reader, start=2):
                 row = {k.strip().lower(): v for k, v in row.items() if k is not None}
                 try:
                     rows.append([float(row[n]) for n in need])
                 except (TypeError, ValueError):
                     raise InputError(f"{path}, line {line}: every value must be a number") from None
+                _check_row(path, line, *rows[-1])
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a text (CSV) file") from None
-    rows = np.array(rows, dtype=np.float64).reshape(-1, 4)
-    if len(rows) == 0 or not np.isfinite(rows).all() or (rows[:, :3] <= 0).any():
-        raise InputError(f"{path}: the table is empty or holds a non-positive thickness, radius or angle")
-    return BendTable(str(path), rows)
+    except csv.Error as exc:
+        raise InputError(f"{path}, line {reader.line_num + 1}: not a CSV bend table ({exc})") from None
+    if not rows:
+        raise InputError(f"{path}: the bend table has no rows")
+    return BendTable(str(path), np.array(rows, dtype=np.float64).reshape(-1, 4))
+
+
+def deduction_range(thickness: float, radius: float, angle: float, *, slack: float = K_SLACK) -> tuple:
+    """The bend deductions, mm, whose neutral layer lies at K-factor ``-slack`` to ``1 + slack`` (``angle`` in degrees).
+
+    Returns ``(low, high)``: ``2 (r + t) tan(a / 2) - a (r + K t)`` at ``K = 1 + slack`` and ``K = -slack``.
+    """
+    a = np.radians(angle)
+    sharp = 2 * (radius + thickness) * np.tan(a / 2)
+    return sharp - a * (radius + (1 + slack) * thickness), sharp - a * max(radius - slack * thickness, 0.0)
+
+
+def _check_row(path, line, thickness, radius, angle, deduction) -> None:
+    where = f"{path}, line {line}"
+    if not all(np.isfinite([thickness, radius, angle, deduction])):
+        raise InputError(f"{where}: every value must be a finite number")
+    if thickness <= 0 or radius <= 0:
+        raise InputError(f"{where}: the thickness and inside radius must be positive mm")
+    if not 0 < angle < 180:
+        raise InputError(f"{where}: the bend angle must be between 0 and 180 degrees, got {angle:g}")
+    low, high = deduction_range(thickness, radius, angle)
+    if not low - ROUNDING <= deduction <= high + ROUNDING:
+        raise InputError(f"{where}: deduction {deduction:g} mm is not a bend of {thickness:g} mm sheet, "
+                         f"R {radius:g}, {angle:g} degrees: it would put the neutral layer outside the sheet "
+                         f"(K-factor 0 to 1 gives {deduction_range(thickness, radius, angle, slack=0)[0]:.3f} to "
+                         f"{deduction_range(thickness, radius, angle, slack=0)[1]:.3f} mm)")
 
 
 def _table(value, option):
@@ -104,5 +150,5 @@ class UnfoldOptions(Options):
                                       "deduction (mm, degrees); it gives every bend instead of the K-factor",
                                 optional=True, check=_table, metavar="CSV")
     fixed_face: int | None = option(None, "the CAD face that keeps its place (shape.faces() index; default the "
-                                          "largest planar face)", integer=True, low=0, optional=True,
+                                          "largest planar face that starts a sheet)", integer=True, low=0, optional=True,
                                     metavar="N")
