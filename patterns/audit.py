@@ -22,6 +22,7 @@ from .options import Options, option
 from .pattern import Pattern
 from .pieces import Drawing
 from .predicates import Overlap, boundary_crossings, crossing_segments, flat_polygon, overlap_verdict
+from .text import counted
 
 __all__ = ["CheckOptions", "Code", "DartReport", "Finding", "Overlap", "PanelReport", "Report", "SeamReport", "Severity",
            "boundary_crossings", "check", "checked_drawing", "crossing_segments", "overlap_verdict"]
@@ -175,7 +176,8 @@ class Report:
 
     def __str__(self) -> str:
         lines = [f"{self.pattern}: {'ok' if self.ok else 'NOT ok'} "
-                 f"({len(self.panels)} panels, {len(self.seams)} seams, {len(self.findings)} findings)"]
+                 f"({counted(len(self.panels), 'panel')}, {counted(len(self.seams), 'seam')}, "
+                 f"{counted(len(self.findings), 'finding')})"]
         lines += [f"  {f.severity.value}: {f.message}" for f in self.findings]
         return "\n".join(lines)
 
@@ -186,13 +188,13 @@ class CheckOptions(Options):
 
     max_strain: float | None = option(None, "largest acceptable triangle strain, a ratio (0.03 = 3 %); triangles "
                                             "above it are findings (the command line then exits with 1)",
-                                      low=0, low_open=True, optional=True, metavar="R")
+                                      optional=True, unit="ratio")
     max_seam_mismatch: float | None = option(None, "largest acceptable difference of a seam's two flat lengths, "
                                                    "mm (above it the command line exits with 1)",
                                              low=0, low_open=True, optional=True, unit="mm")
     area_tolerance: float | None = option(0.05, "a panel whose flat area differs from its 3D area by more than "
-                                                "this ratio is not a usable pattern of it (an error; None: not "
-                                                "checked)", low=0, low_open=True, optional=True, metavar="R")
+                                                "this ratio (0.05 = 5 %) is not a usable pattern of it (an error; none: "
+                                                "not checked)", optional=True, unit="ratio")
     max_distortion: float | None = option(2.0, "a triangle laid flat at more than this factor of its 3D size in "
                                                "some direction (2: doubled or halved) is grossly distorted; a "
                                                "panel with more than 1 % of its area so is not a usable pattern "
@@ -308,7 +310,7 @@ def _placed_like(item, drawing: Drawing):
 def checked_drawing(source, drawing: Drawing, options: CheckOptions | None = None) -> tuple:
     """``(Report, Drawing)``: the check of ``source`` (a pattern, a blank or a list of them) as its pieces lie
     in ``drawing`` -- every point and message in the drawing's frame -- and the drawing with that report
-    and each piece's findings."""
+    and each piece's findings: its own about its drawing (a label left out) and the check's about it."""
     items = list(source) if isinstance(source, (list, tuple)) else [source]
     placed = [_placed_like(item, drawing) for item in items]
     report = check(placed if len(placed) > 1 else placed[0], options)
@@ -319,7 +321,8 @@ def checked_drawing(source, drawing: Drawing, options: CheckOptions | None = Non
         s = piece.source
         about = panel_names.get((s.part, s.index)) if s.kind == "panel" else s.part
         first = s.copy == 0 and not piece.placement.mirrored
-        pieces.append(replace(piece, findings=tuple(f for f in report.findings if first and about in f.panels)))
+        own = tuple(f for f in piece.findings if f.code is Code.LABEL_LEFT_OUT)
+        pieces.append(replace(piece, findings=own + tuple(f for f in report.findings if first and about in f.panels)))
     return report, replace(drawing, pieces=tuple(pieces), report=report.to_dict())
 
 
@@ -389,7 +392,7 @@ def _panel_report(flat, max_strain):
         tips = np.array([uv[d.tip] for d in flat.darts])
         length = sum(d.length_3d for d in flat.darts)
         findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), tips, (),
-                                None, f"panel {flat.name}: {len(flat.darts)} darts cut to keep the strain within "
+                                None, f"panel {flat.name}: {counted(len(flat.darts), 'dart')} cut to keep the strain within "
                                       f"the limit ({length:.1f} mm of cuts; points: their tips)"))
     if not res.converged:
         findings.append(Finding(Code.NOT_CONVERGED, Severity.NOTE, (flat.name,), np.zeros((0, 2)), (), None,

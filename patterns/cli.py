@@ -28,55 +28,20 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import signal
 import sys
 import time
 from pathlib import Path
 
 from .errors import InputError, PatternsError, Terminated
+from .terminal import BatchProgress, Progress, Terminal, foreign_home
+from .text import counted
 
 __all__ = ["main"]
 
 EXIT_OK, EXIT_CHECK, EXIT_INPUT = 0, 1, 2
 """Exit codes."""
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
-
-
-class Progress:
-    """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
-
-    def __init__(self, label: str, *, stream=None, enabled: bool | None = None):
-        self.stream = stream or sys.stderr
-        self.enabled = _isatty(self.stream) if enabled is None else enabled
-        self.label = label
-        self._last = -1.0
-
-    def __call__(self, done: int, total: int) -> None:
-        if not self.enabled or total <= 0:
-            return
-        frac = min(max(done / total, 0.0), 1.0)
-        if frac - self._last < 0.01 and frac < 1.0:
-            return
-        self._last = frac
-        width = 30
-        bar = "#" * int(frac * width) + "-" * (width - int(frac * width))
-        self.stream.write(f"\r{self.label} [{bar}] {100 * frac:3.0f}%")
-        if frac >= 1.0:
-            self.stream.write("\n")
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.enabled and 0 <= self._last < 1.0:
-            self.stream.write("\n")
-            self.stream.flush()
-
-
-def _isatty(stream) -> bool:
-    try:
-        return stream.isatty()
-    except (AttributeError, ValueError, OSError):
-        return False
 
 
 class _Parser(argparse.ArgumentParser):
@@ -174,7 +139,26 @@ def _parser() -> argparse.ArgumentParser:
     add_arguments(batch.add_argument_group("unfolding (with --unfold)"), UnfoldOptions)
     checking(batch, report=False)
     output(batch)
+    parser.commands = sub.choices  # {command: its parser}, for the unknown options' "did you mean"
     return parser
+
+
+def _parse(argv) -> argparse.Namespace:
+    """The parsed command line; an unknown option is named with the command's closest one ("did you mean
+    --seam-allowance?") and the command's own --help, not the list of commands."""
+    from .options import suggest
+
+    parser = _parser()
+    args, extras = parser.parse_known_args(argv)
+    if extras:
+        command = parser.commands[args.command]
+        known = [flag for action in command._actions for flag in action.option_strings]
+        word = next((e for e in extras if e.startswith("-")), extras[0])
+        if word.startswith("-"):
+            flag = word.split("=", 1)[0]
+            raise InputError(f"unknown option {flag}{suggest(flag, known)} ({command.prog} --help lists the options)")
+        raise InputError(f"unexpected argument {word!r} ({command.prog} --help lists the arguments)")
+    return args
 
 
 def _records(args, name=None):
@@ -242,8 +226,19 @@ def _verdict(report) -> int:
 def _loaded(model, seconds):
     if model.bookkeeping != type(model.bookkeeping)():
         print(f"{model.name}: {model.bookkeeping}")
-    print(f"{model.name}: {len(model.panels)} panels, {len(model.seams)} seams "
+    print(f"{model.name}: {counted(len(model.panels), 'panel')}, {counted(len(model.seams), 'seam')} "
           f"(target edge {model.max_edge:.3g} mm), loaded in {seconds:.2f} s")
+
+
+def _nested(nest) -> None:
+    """The nest's line: what it is, and where its time went (a search, or a marker kept from an earlier run)."""
+    if nest is None:
+        return
+    if nest.cached:
+        print(f"nested on {nest} (a marker kept from an earlier run with the same pieces and options, "
+              f"{nest.seconds:.1f} s; --no-nest-cache searches anew)")
+    else:
+        print(f"nested on {nest} (sparrow searched {nest.seconds:.1f} s)")
 
 
 def _wrote(result, records):
@@ -305,9 +300,8 @@ def _cmd_flatten(args) -> int:
     run = _run_part(args, {"pattern": args.output, "report": args.report, "heat_map": args.heat_map,
                            "preview": args.preview}, records)
     part = run.part
-    print(f"flattened ({records['flatten'].method}) in {part.seconds['flatten']:.2f} s")
-    if part.nest is not None:
-        print(f"nested on {part.nest} (sparrow, {part.nest.seconds:.1f} s)")
+    print(f"flattened ({records['flatten'].method}) in {part.seconds['flatten']:.2f} s (the flattening alone)")
+    _nested(part.nest)
     _print_panels(part.report)
     _wrote(run, records)
     return _verdict(part.report)
@@ -353,6 +347,7 @@ DEMO_FILES = (("cup.step", "the part: a hemisphere cup in four panels, built wit
 
 
 def _cmd_demo(args) -> int:
+    import shlex
     from dataclasses import replace
 
     from build123d import export_step
@@ -360,11 +355,13 @@ def _cmd_demo(args) -> int:
     from .audit import CheckOptions, checked_drawing
     from .export import heat_map, preview_dxf, write
     from .files import Outputs, output_target
+    from .findings import Code
     from .flattening import flatten
     from .pieces import drawing_of
     from .reading import load
     from .samples import cup
 
+    limit = 0.05  # the strain limit the demo checks against, said before the tables; the cup exceeds it
     out = args.output
     if out.exists() and not out.is_dir():
         raise InputError(f"{out}: is a file; name a folder for the demo")
@@ -382,7 +379,7 @@ def _cmd_demo(args) -> int:
             model = replace(load(step), name="cup.step")  # read from its temporary name
             pattern = flatten(model)
             drawing = drawing_of(pattern, seam_allowance=10.0)
-            report, checked = checked_drawing(pattern, drawing, CheckOptions(max_strain=0.05))
+            report, checked = checked_drawing(pattern, drawing, CheckOptions(max_strain=limit))
             dxf = files.stage(out / "cup.dxf", what="DXF file")
             write(drawing, dxf)
             write(drawing, files.stage(out / "cup_astm.dxf", what="DXF file"), profile="astm")
@@ -397,9 +394,20 @@ def _cmd_demo(args) -> int:
             except OSError:
                 pass
         raise
+    print(f"patterns demo: {model.name}, a hemisphere in {counted(len(model.panels), 'panel')}, checked against a "
+          f"strain limit of {100 * limit:g} % (as --max-strain {limit:g} would)")
     _print_panels(report)
-    _verdict(report)  # shows what a strain limit of 5 % finds on a sphere cut in quarters
-    print(f"patterns demo: {len(model.panels)} panels, {len(model.seams)} seams; wrote:")
+    _verdict(report)
+    if any(f.code is Code.STRAIN_ABOVE_LIMIT for f in report.findings):
+        worst = max(p.strain_max for p in report.panels)
+        gores = shlex.join(["patterns", "flatten", os.fsdecode(out / "cup.step"), "-o", os.fsdecode(out / "cup_gores.dxf"),
+                            "--seam-allowance", "10", "--dart-strain", f"{limit:g}", "--gores",
+                            "--max-strain", f"{limit:g}"])
+        print(f"why: a hemisphere is curved in two directions, and a doubly curved panel cannot lie flat without "
+              f"stretching: these quarter spheres stretch up to {100 * worst:.2f} %, above the {100 * limit:g} % "
+              f"limit. Cut into gores (or, without --gores, darts), the cup comes within it:")
+        print(f"  {gores}")
+    print(f"patterns demo: {counted(len(model.panels), 'panel')}, {counted(len(model.seams), 'seam')}; wrote:")
     for name, what in DEMO_FILES:
         print(f"  {out / name}  {what}")
     return EXIT_OK
@@ -412,7 +420,7 @@ def _cmd_batch(args) -> int:
     records = _records(args)  # every option checked before any file is read
     options = from_arguments(BatchOptions, args)
     files, _ = plan_batch(args.folder, args.output, unfold=options.unfold)
-    progress = _BatchProgress(len(files), quiet=options.quiet)
+    progress = BatchProgress(len(files), quiet=options.quiet)
     result = batch(files, args.output, records=records, options=options, on_row=progress.row,
                    on_start=progress.start)
     progress.close()
@@ -427,52 +435,9 @@ def _cmd_batch(args) -> int:
                        if result.count(s))
     written = sum(bool(r.written) for r in result.rows)
     stop = f"{result.stopped}: " if result.stopped else ""
-    print(f"batch: {stop}{len(result.rows)} files: {counts} ({result.where}); "
+    print(f"batch: {stop}{counted(len(result.rows), 'file')}: {counts} ({result.where}); "
           f"{written} written to {os.fsdecode(args.output)}", file=sys.stderr if result.stopped else sys.stdout)
     return result.exit_code
-
-
-class _BatchProgress:
-    """A batch's progress: a bar with the file names, failures and time left on a terminal; else a line
-    per finished file (for logs, CI, nohup); nothing with --quiet."""
-
-    def __init__(self, total: int, *, quiet: bool = False, stream=None):
-        self.total, self.quiet = total, quiet
-        self.stream = stream or sys.stderr
-        self.bar = _isatty(self.stream) and not quiet
-        self.start_time, self.done, self.bad, self.running = time.monotonic(), 0, 0, []
-
-    def start(self, name: str) -> None:
-        self.running.append(name)
-        self._draw()
-
-    def row(self, row, done: int, total: int) -> None:
-        self.done = done
-        self.bad += row.status not in ("ok", "check failed")
-        if row.file in self.running:
-            self.running.remove(row.file)
-        if self.quiet:
-            return
-        if not self.bar:
-            reason = f": {row.reason}" if row.reason else ""
-            print(f"[{done}/{total}] {row.file}: {row.status}{reason} ({row.seconds:.1f} s)", file=self.stream,
-                  flush=True)
-        self._draw()
-
-    def _draw(self) -> None:
-        if not self.bar:
-            return
-        elapsed = time.monotonic() - self.start_time
-        left = f", about {elapsed / self.done * (self.total - self.done):.0f} s left" if self.done else ""
-        names = ", ".join(self.running[:2]) + (" ..." if len(self.running) > 2 else "")
-        text = f"batch {self.done}/{self.total}, {self.bad} failed{left}  {names}"
-        self.stream.write("\r" + text[:100].ljust(100))
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.bar:
-            self.stream.write("\n")
-            self.stream.flush()
 
 
 def _cmd_unfold(args) -> int:
@@ -495,8 +460,9 @@ def _cmd_unfold(args) -> int:
             out.commit()
     blank = part.subject
     w, h = blank.size
-    print(f"{blank.name}: sheet {blank.thickness:g} mm, {len(blank.bends)} bends, {len(blank.holes)} holes; "
-          f"blank {w:.2f} x {h:.2f} mm, area {blank.area:.1f} mm2, usage {blank.usage:.1%} (unfolded in "
+    print(f"{blank.name}: sheet {blank.thickness:g} mm, {counted(len(blank.bends), 'bend')}, "
+          f"{counted(len(blank.holes), 'hole')}; "
+          f"blank {w:.2f} x {h:.2f} mm, area {blank.area:.1f} mm2, usage {blank.usage:.1%} (read and unfolded in "
           f"{part.seconds['flatten']:.2f} s)")
     rows = [("bend", "direction", "angle deg", "inside R mm", "allowance mm")]
     rows += [(str(k), b.direction, f"{b.angle:.2f}", f"{b.inside_radius:g}", f"{b.allowance:.4f}")
@@ -513,8 +479,7 @@ def _cmd_unfold(args) -> int:
     if not blank.ok:
         print(f"{args.output}: not written (the blank cannot be cut as it is)")
         return EXIT_CHECK
-    if part.nest is not None:
-        print(f"nested on {part.nest} (sparrow, {part.nest.seconds:.1f} s)")
+    _nested(part.nest)
     _wrote(_Run(planned, part), records)
     return EXIT_OK
 
@@ -524,96 +489,29 @@ COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "de
 
 
 # --------------------------------------------------------------------------- #
-# The terminal: names are data, a closed pipe is not an error, signals end cleanly
+# Signals end cleanly; the terminal (patterns.terminal) shows names as data
 # --------------------------------------------------------------------------- #
-
-_CONTROL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ud800-\udfff]")
-
-
-def _visible(match: re.Match) -> str:
-    code = ord(match.group(0))
-    return f"\\x{code - 0xDC00:02x}" if 0xDC80 <= code <= 0xDCFF else f"\\x{code:02x}" if code < 0x100 \
-        else f"\\u{code:04x}"
-
-
-class _Terminal:
-    """Standard output or error as the command line writes it.
-
-    Every control character but newline, tab and carriage return, and every
-    byte of a file name that is not UTF-8, is written as a visible escape
-    (``\\x1b``): a file named with an escape sequence cannot drive the terminal,
-    and an undecodable name cannot stop the run.  Output to a closed pipe
-    (``patterns flatten part.step | head -1``) is dropped: the files are still
-    written and no traceback is shown.
-    """
-
-    def __init__(self, stream):
-        self._stream, self._gone = stream, False
-
-    def write(self, text: str) -> int:
-        if not self._gone:
-            try:
-                return self._stream.write(_CONTROL.sub(_visible, text))
-            except BrokenPipeError:
-                self._close()
-        return len(text)
-
-    def flush(self) -> None:
-        if not self._gone:
-            try:
-                self._stream.flush()
-            except BrokenPipeError:
-                self._close()
-
-    def _close(self) -> None:
-        self._gone = True
-        try:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
-        except (OSError, ValueError, AttributeError):  # not a real file (a test's capture)
-            pass
-
-    def __getattr__(self, name):
-        return getattr(self._stream, name)
 
 
 def _on_sigterm(signum, frame):
     raise Terminated()
 
 
-def _foreign_home() -> None:
-    """``sudo -u user patterns ...`` without ``-H`` keeps root's HOME, which the user cannot read: ezdxf fails
-    at import reading its settings and its font cache there, and matplotlib warns.  Then none looks there:
-    the settings and caches (``XDG_CONFIG_HOME``, ``XDG_CACHE_HOME``, ``MPLCONFIGDIR``; the marker cache too)
-    go to a folder of this run's, removed at exit."""
-    import atexit
-    import shutil
-    import tempfile
-
-    home = os.path.expanduser("~")
-    if not os.path.isdir(home) or os.access(home, os.R_OK | os.X_OK):
-        return
-    own = tempfile.mkdtemp(prefix="patterns-home-")
-    atexit.register(shutil.rmtree, own, ignore_errors=True)
-    for name in ("XDG_CONFIG_HOME", "XDG_CACHE_HOME", "MPLCONFIGDIR"):
-        if name not in os.environ or not os.access(os.environ[name], os.R_OK | os.W_OK | os.X_OK):
-            os.environ[name] = own
-
-
 def main(argv=None) -> int:
     """Run the command line; returns the exit code."""
-    _foreign_home()
+    foreign_home()
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
     argv = [a for a in argv if a != "--debug"]  # anywhere on the line
     saved = sys.stdout, sys.stderr
-    sys.stdout, sys.stderr = _Terminal(sys.stdout), _Terminal(sys.stderr)
+    sys.stdout, sys.stderr = Terminal(sys.stdout), Terminal(sys.stderr)
     previous = None
     try:
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
     except ValueError:  # not the main thread (a test harness): no handler
         pass
     try:
-        args = _parser().parse_args(argv)
+        args = _parse(argv)
         return COMMANDS[args.command](args)
     except PatternsError as exc:
         if debug:

@@ -214,8 +214,8 @@ class Outputs:
     Examples
     --------
     >>> with Outputs() as out:                                   # doctest: +SKIP
-    ...     pattern.to_dxf(out.stage("part.dxf", what="DXF file"))
-    ...     report.to_json(out.stage("part.json", what="report"))
+    ...     patterns.write(pattern, out.stage("part.dxf", what="DXF file"))
+    ...     patterns.write(pattern, out.stage("part.json", what="report"))
     ...     out.commit()
     """
 

@@ -53,6 +53,9 @@ class Code(str, Enum):
     """A bend with no flat face on one side."""
     MESHED_FACE = "meshed-face"
     """A face of a sheet that is no plane, cylinder or cone: meshed and flattened, with strain."""
+    LABEL_LEFT_OUT = "label-left-out"
+    """A label (a piece's name, a seam's or a bend's) that fits nowhere on its piece at the least text height:
+    left out of the drawing rather than drawn smaller or across a cut."""
 
 
 @dataclass(frozen=True, eq=False)

@@ -154,7 +154,8 @@ class PartResult:
     written : dict
         ``{kind: staged path}`` of every output written.
     seconds : dict
-        ``{"load": s, "flatten": s, "write": s}``.
+        Seconds of each step, each alone: ``{"load", "flatten", "nest", "check", "write"}`` (an unfold's
+        ``"flatten"`` is its unfolding; a blank that cannot be cut has ``"load"`` and ``"flatten"`` only).
     nest : patterns.Layout or None
     preview_dpi : float or None
         The resolution of a PNG preview (lowered for a large drawing).
@@ -241,9 +242,13 @@ def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, progr
         loaded(model, seconds["load"])
     start = time.perf_counter()
     pattern = flatten(model, records["flatten"], progress=progress)
-    drawing, nest = _laid_out(pattern, records)
-    report, checked = checked_drawing(pattern, drawing, records["check"])
     seconds["flatten"] = time.perf_counter() - start
+    start = time.perf_counter()
+    drawing, nest = _laid_out(pattern, records)
+    seconds["nest"] = time.perf_counter() - start
+    start = time.perf_counter()
+    report, checked = checked_drawing(pattern, drawing, records["check"])
+    seconds["check"] = time.perf_counter() - start
     start = time.perf_counter()
     written, dpi = _write(pattern, drawing, checked, records, outputs, stage)
     seconds["write"] = time.perf_counter() - start
@@ -268,11 +273,15 @@ def unfold_part(source, records: dict, *, outputs: dict, stage: Callable,
         seconds["flatten"] = time.perf_counter() - start
         return PartResult(blank, None, check(blank, records["check"]), drawing_of(blank, records["pieces"]),
                           seconds=seconds, comparison=comparison)
+    seconds["flatten"] = time.perf_counter() - start
+    start = time.perf_counter()
     drawing, nest = _laid_out(blank, records)
+    seconds["nest"] = time.perf_counter() - start
+    start = time.perf_counter()
     report, checked = checked_drawing(blank, drawing, records["check"])
     if comparison is not None:
         checked = replace(checked, report={**checked.report, "comparison": comparison.to_dict(reference.path)})
-    seconds["flatten"] = time.perf_counter() - start
+    seconds["check"] = time.perf_counter() - start
     start = time.perf_counter()
     written, dpi = _write(blank, drawing, checked, records, outputs, stage)
     seconds["write"] = time.perf_counter() - start

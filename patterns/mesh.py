@@ -20,6 +20,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from .errors import InputError, MeshTopologyError
+from .text import counted
 from .units import LARGEST_LENGTH
 
 __all__ = [
@@ -156,7 +157,7 @@ def as_mesh_arrays(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, 
     bad = ~np.isfinite(v).all(axis=1)
     if bad.any():
         raise InputError(
-            f"{name}: {int(bad.sum())} vertices have NaN or infinite coordinates "
+            f"{name}: {counted(int(bad.sum()), 'vertex')} {'has' if bad.sum() == 1 else 'have'} NaN or infinite coordinates "
             f"(first: vertex {int(np.flatnonzero(bad)[0])})"
         )
     far = (np.abs(v) > LARGEST_LENGTH).any(axis=1)
@@ -423,7 +424,7 @@ def validate_mesh(vertices, faces, *, name: str = "mesh") -> tuple[np.ndarray, n
     used[f.ravel()] = True
     if not used.all():
         raise InputError(
-            f"{name}: {int((~used).sum())} vertices are used by no face "
+            f"{name}: {counted(int((~used).sum()), 'vertex')} {'is' if (~used).sum() == 1 else 'are'} used by no face "
             f"(first: vertex {int(np.flatnonzero(~used)[0])}); remove them first"
         )
 

@@ -13,6 +13,7 @@ from enum import Enum
 import numpy as np
 
 from .mesh import face_areas, longest_first, polyline_length, validate_mesh
+from .text import counted
 
 __all__ = ["Bookkeeping", "panel_from_mesh", "Model", "Panel", "Seam", "Surface", "SurfaceKind"]
 
@@ -190,7 +191,7 @@ class Bookkeeping:
     units: str = "mm"
 
     def __str__(self) -> str:
-        parts = [f"{self.welded} vertices welded" if self.welded else "",
+        parts = [f"{counted(self.welded, 'vertex')} welded" if self.welded else "",
                  f"{self.unused} unused vertices dropped" if self.unused else "",
                  f"{self.cuts} cut{'s' if self.cuts != 1 else ''} made to open tubes" if self.cuts else "",
                  f"{self.split} closed piece{'s' if self.split != 1 else ''} split into panels along creases"
@@ -227,7 +228,7 @@ class Model:
         return tuple(s for s in self.seams if panel in s.panels)
 
     def __repr__(self) -> str:
-        return (f"Model({self.name!r}, {len(self.panels)} panels, {len(self.seams)} seams, "
+        return (f"Model({self.name!r}, {counted(len(self.panels), 'panel')}, {counted(len(self.seams), 'seam')}, "
                 f"max_edge={self.max_edge:.4g} mm)")
 
 

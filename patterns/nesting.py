@@ -46,7 +46,7 @@ from shapely import affinity
 from .curves import Motion
 from .errors import InputError, LayoutError, PatternsError
 from .files import atomic_output
-from .options import Options, check_number, option
+from .options import Options, check_number, label, option
 from .pieces import Drawing, Piece, PieceOptions, pieces_of
 from .pieces.drawing import place_nest
 
@@ -144,16 +144,17 @@ class NestOptions(Options):
                        metavar="N")
     cache: bool = option(True, "keep each marker sparrow finds and give the same one again for the same pieces "
                                "and options (sparrow's search is bound by time, so a rerun on a busier machine "
-                               "could stop at another); --no-nest-cache searches anew", flag="--no-nest-cache")
+                               "could stop at another); --no-nest-cache searches anew", flag="--no-nest-cache",
+                               off="search anew: neither reuse a kept marker nor keep the new one")
 
     def __post_init__(self):
         super().__post_init__()
         if self.width is not None and self.sheet is not None:
-            raise InputError("nest on a roll (width) or on sheets (sheet), not both")
+            raise InputError(f"nest on a roll ({label('width')}) or on sheets ({label('sheet')}), not both")
         room = self.gap + 2 * self.margin  # a gap wider than the stock: refused before sparrow sees it
         if self.width is not None and room >= self.width or self.sheet is not None and room >= min(self.sheet):
             stock = f"{self.width:g} mm roll" if self.sheet is None else f"{self.sheet[0]:g} x {self.sheet[1]:g} mm sheet"
-            raise InputError(f"nest_gap {self.gap:g} mm (and margin {self.margin:g} mm each side) is as wide as the "
+            raise InputError(f"{label('gap')} {self.gap:g} mm (and {label('margin')} {self.margin:g} mm each side) is as wide as the "
                              f"{stock}: no two pieces could lie side by side")
 
     @property
@@ -204,7 +205,9 @@ class Layout:
     sheets : tuple of Sheet
         Sheet by sheet, for a nest on sheets; empty on a roll.
     seconds : float
-        The search's time.
+        The nest's time: sparrow's searches (or the kept markers read), and checking the result.
+    cached : bool
+        Every marker came from the marker cache (``NestOptions.cache``): sparrow did not search.
     sources : tuple
         The patterns and blanks nested (their check report follows the pieces into the drawing).
     """
@@ -220,6 +223,7 @@ class Layout:
     seconds: float = 0.0
     options: NestOptions = field(default_factory=NestOptions)
     sources: tuple = ()
+    cached: bool = False
 
     @property
     def efficiency(self) -> float:
@@ -309,8 +313,9 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
             checked.add(key)
             _check_fits(name, piece.name, shape, across, along, opts.rotations)
     start = time.perf_counter()
+    searched = []  # per marker: True if sparrow searched, False if it came from the cache
     try:
-        placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline)
+        placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline, searched=searched)
         laid = tuple(piece.moved(Motion(*placements[i])) for i, piece in enumerate(every))
         placed = [_outline(piece, opts.margin) for piece in laid]
         _verify(name, laid, placed, across, opts, stock)
@@ -318,7 +323,8 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
         if not opts.cache:
             raise
         # a kept marker that fails the check (edited, or from a broken run): searched anew, and kept again
-        placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline, refresh=True)
+        placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline, refresh=True,
+                                            searched=searched)
         laid = tuple(piece.moved(Motion(*placements[i])) for i, piece in enumerate(every))
         placed = [_outline(piece, opts.margin) for piece in laid]
         _verify(name, laid, placed, across, opts, stock)
@@ -334,7 +340,7 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
         rects = ((0.0, 0.0, across, length),)
     sources = tuple(item for item in items if not isinstance(item, Piece))
     return Layout(name, laid, rects, float(across), float(length), float(used), area_pieces, tuple(sheets), seconds,
-                  opts, sources)
+                  opts, sources, cached=bool(searched) and not any(searched))
 
 
 def check_piece_count(name: str, counts, opts: NestOptions) -> int:
@@ -352,13 +358,14 @@ def _left(deadline: float) -> int:
     return max(1, int(deadline - time.monotonic()))
 
 
-def _placed(shapes, pieces, across, opts, name, deadline, *, refresh=False):
-    """``(placements, sheets, stock)``: sparrow's placements on the roll, or sheet after sheet."""
+def _placed(shapes, pieces, across, opts, name, deadline, *, refresh=False, searched=None):
+    """``(placements, sheets, stock)``: sparrow's placements on the roll, or sheet after sheet; ``searched``
+    gets a bool per marker (True: sparrow searched; False: a kept one)."""
     if opts.sheet is None:
         placements = _solve(shapes, list(range(len(shapes))), across, opts, name, seconds=_left(deadline),
-                            refresh=refresh)
+                            refresh=refresh, searched=searched)
         return placements, (), [(0.0, 0.0, across, None)]
-    return _fill_sheets(shapes, pieces, opts, name, deadline, refresh)
+    return _fill_sheets(shapes, pieces, opts, name, deadline, refresh, searched)
 
 
 def _outline(piece: Piece, margin: float):
@@ -401,9 +408,11 @@ def _tolerance(across: float) -> float:
     return 1e-6 * max(float(across), 1.0)
 
 
-def _solve(shapes, which, across, opts, name, *, seconds: int | None = None, refresh: bool = False) -> dict:
+def _solve(shapes, which, across, opts, name, *, seconds: int | None = None, refresh: bool = False,
+           searched: list | None = None) -> dict:
     """Sparrow on the pieces ``which``: ``{piece: (angle rad, dx, dy)}`` on a roll ``across`` wide, searching
-    ``seconds`` (at most ``opts.time_limit``, the marker's key); ``refresh`` searches anew over a kept marker."""
+    ``seconds`` (at most ``opts.time_limit``, the marker's key); ``refresh`` searches anew over a kept marker;
+    ``searched`` (a list) gets True if sparrow searched, False if the marker was a kept one."""
     points = [_item_points(shapes[i]) for i in which]
     # sparrow keeps every item the separation away from the strip's edges too, and each item it sees is
     # the outline grown by SIMPLIFY: a strip wider by both on either side, and everything moved back by
@@ -416,6 +425,8 @@ def _solve(shapes, which, across, opts, name, *, seconds: int | None = None, ref
             "orientations": _ANGLES[opts.rotations], "gap": float(opts.gap), "time": int(opts.time_limit),
             "seed": int(opts.seed)}
     placed = _remembered(task) if opts.cache and not refresh else None
+    if searched is not None:
+        searched.append(placed is None)
     if placed is None:
         placed = _sparrow(task, name, seconds=min(int(opts.time_limit), seconds or int(opts.time_limit)))
         if opts.cache:
@@ -537,7 +548,7 @@ FILL = 0.75
 """The share of a sheet pieces are expected to take, for sharing the nest's time among the sheets to come."""
 
 
-def _fill_sheets(shapes, pieces, opts, name, deadline, refresh=False):
+def _fill_sheets(shapes, pieces, opts, name, deadline, refresh=False, searched=None):
     """Sheet after sheet: the pieces nested on a strip as wide as a sheet, those lying wholly within the
     sheet's length kept on it; then each piece left over, largest first, tried on that sheet too (a short
     search of the sheet's pieces and it, kept if all fit), until the sheet's time is spent; the rest go on
@@ -551,19 +562,19 @@ def _fill_sheets(shapes, pieces, opts, name, deadline, refresh=False):
         start = time.monotonic()
         expected = max(1, math.ceil(sum(shapes[i].area for i in left) / (FILL * length * width)))
         share = max(1.0, (deadline - start) / expected)
-        found = _solve(shapes, left, width, opts, name, seconds=max(1, int(share / 2)), refresh=refresh)
+        found = _solve(shapes, left, width, opts, name, seconds=max(1, int(share / 2)), refresh=refresh, searched=searched)
         ends = _ends(shapes, found)
         on_sheet = [i for i in left if ends[i] <= length + 1e-9]
         if not on_sheet:  # the nearest piece alone, from the start of the sheet
             i = min(left, key=lambda j: found[j][2])
-            found = _solve(shapes, [i], width, trial, name, seconds=1, refresh=refresh)
+            found = _solve(shapes, [i], width, trial, name, seconds=1, refresh=refresh, searched=searched)
             on_sheet = [i]
         found = {i: found[i] for i in on_sheet}
         for i in sorted((j for j in left if j not in on_sheet), key=lambda j: -shapes[j].area):
             if time.monotonic() - start + 1 > share:
                 break
             attempt = _solve(shapes, on_sheet + [i], width, trial, name, seconds=max(1, int(share / 10)),
-                             refresh=refresh)
+                             refresh=refresh, searched=searched)
             if max(_ends(shapes, attempt).values()) <= length + 1e-9:
                 on_sheet.append(i)
                 found = attempt

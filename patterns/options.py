@@ -15,6 +15,8 @@
 
 from __future__ import annotations
 
+import contextvars
+import difflib
 import math
 import numbers
 from collections.abc import Callable
@@ -27,8 +29,26 @@ import numpy as np
 from .errors import InputError
 from .units import LARGEST_LENGTH
 
-__all__ = ["Options", "Spec", "add_arguments", "check_number", "cli_flags", "from_arguments", "from_text", "is_number",
-           "option"]
+__all__ = ["Options", "Spec", "add_arguments", "check_number", "check_ratio", "cli_flags", "from_arguments", "from_text",
+           "is_number", "label", "option", "suggest"]
+
+_LABELS: contextvars.ContextVar = contextvars.ContextVar("patterns_option_labels", default=None)
+"""``{option name: what to call it}`` while a record is made from the command line's flags (the flags)."""
+
+
+def label(name: str) -> str:
+    """What a message calls option ``name``: its CLI flag while the command line makes a record, else ``name``.
+
+    A record's own cross-checks (``__post_init__``) name their options through it, so that the command line's
+    errors name the flag the user typed (``--nest-gap``) and the API's the keyword (``gap``).
+    """
+    return (_LABELS.get() or {}).get(name, name)
+
+
+def suggest(word: str, choices) -> str:
+    """``"; did you mean X?"`` for the closest of ``choices`` to ``word`` (a mistyped option), or ``""``."""
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return f"; did you mean {close[0]}?" if close else ""
 
 
 def is_number(value, *, integer: bool = False) -> bool:
@@ -68,6 +88,20 @@ def check_number(value, option: str, *, low=None, high=None, low_open: bool = Fa
         raise InputError(f"{prefix}{option} must be {_describe(low, high, low_open, high_open, integer)}, "
                          f"got {value!r}")
     return int(value) if integer else float(value)
+
+
+def check_ratio(value, option: str, *, name: str | None = None) -> float:
+    """A strain or tolerance given as a ratio, ``0 < value <= 1`` (``0.03`` is 3 %), or InputError.
+
+    Every strain option takes this one rule: a ratio, never a percentage, so ``3`` (meant as 3 %) is
+    refused with the way to write it instead of being taken as 300 %.
+    """
+    prefix = f"{name}: " if name else ""
+    if not is_number(value) or not np.isfinite(value) or not 0 < value <= 1:
+        hint = f"; {value:g} % is {value / 100:g}" if is_number(value) and np.isfinite(value) and 1 < value <= 100 \
+            else ""
+        raise InputError(f"{prefix}{option} must be a ratio > 0 and <= 1 (0.03 means 3 %), got {value!r}{hint}")
+    return float(value)
 
 
 def _describe(low, high, low_open, high_open, integer) -> str:
@@ -124,9 +158,13 @@ class Spec:
     repeat : bool
         The CLI flag may be given several times; the values come as a list.
     metavar : str, optional
-    unit : {"mm"}, optional
-        A length in millimetres: at most :data:`~patterns.units.LARGEST_LENGTH`
-        (whatever ``high`` says), shown as ``MM`` on the command line.
+    unit : {"mm", "ratio"}, optional
+        ``"mm"``: a length in millimetres, at most :data:`~patterns.units.LARGEST_LENGTH`
+        (whatever ``high`` says), shown as ``MM`` on the command line.  ``"ratio"``:
+        a strain or tolerance, ``0 < value <= 1`` (:func:`check_ratio`: ``0.03`` is 3 %).
+    off : str, optional
+        For an option that is on by default: the help of the command line's
+        ``--no-...`` flag, saying what the flag does (required there).
     """
 
     help: str
@@ -143,11 +181,19 @@ class Spec:
     repeat: bool = False
     metavar: str | None = None
     unit: str | None = None
+    off: str | None = None
 
     def __post_init__(self):
         if self.unit == "mm":
             object.__setattr__(self, "high", LARGEST_LENGTH if self.high is None else min(self.high, LARGEST_LENGTH))
             object.__setattr__(self, "metavar", self.metavar or "MM")
+        elif self.unit == "ratio":
+            object.__setattr__(self, "low", 0.0)
+            object.__setattr__(self, "low_open", True)
+            object.__setattr__(self, "high", 1.0)
+            object.__setattr__(self, "metavar", self.metavar or "R")
+        elif self.unit is not None:
+            raise ValueError(f"unit must be 'mm' or 'ratio', got {self.unit!r}")
 
     def validate(self, value, option: str, default):
         """``value`` checked (numbers as Python numbers), or InputError naming ``option``."""
@@ -165,6 +211,8 @@ class Spec:
             if not isinstance(value, (bool, np.bool_)):
                 raise InputError(f"{option} must be True or False, got {value!r}")
             return bool(value)
+        if self.unit == "ratio":
+            return check_ratio(value, option)
         if self.integer or self.low is not None or self.high is not None or is_number(default):
             return check_number(value, option, low=self.low, high=self.high, low_open=self.low_open,
                                 high_open=self.high_open, integer=self.integer)
@@ -196,7 +244,7 @@ class Options:
         for f in fields(self):
             spec = f.metadata.get("spec")
             if spec is not None:
-                object.__setattr__(self, f.name, spec.validate(getattr(self, f.name), f.name, f.default))
+                object.__setattr__(self, f.name, spec.validate(getattr(self, f.name), label(f.name), f.default))
 
     @classmethod
     def of(cls, options=None, keywords=None, *, name: str | None = None):
@@ -215,7 +263,8 @@ class Options:
         known = [f.name for f in fields(cls)]
         unknown = sorted(set(keywords) - set(known))
         if unknown:
-            raise InputError(f"{prefix}unknown option {unknown[0]!r}; the options are {', '.join(known)}")
+            raise InputError(f"{prefix}unknown option {unknown[0]!r}{suggest(unknown[0], known)}; the options are "
+                             f"{', '.join(known)}")
         try:
             return replace(options, **keywords) if options is not None else cls(**keywords)
         except InputError as exc:
@@ -296,20 +345,33 @@ def add_arguments(parser, record: type, *, skip: tuple = ()) -> None:
             continue
         text = spec.help.replace("%", "%%")
         if isinstance(f.default, bool):
-            if f.default:
+            if f.default:  # the flag turns it off: its help says what the flag does, not what the default is
+                if spec.off is None:
+                    raise TypeError(f"{record.__name__}.{f.name}: an option on by default needs off= (its --no- help)")
                 flag = spec.flag or "--no-" + f.name.replace("_", "-")
-                parser.add_argument(flag, dest=_dest(flag), action="store_true", help=text)
-            else:
-                parser.add_argument(flag, dest=_dest(flag), action="store_true", help=text)
+                text = spec.off.replace("%", "%%")
+            parser.add_argument(flag, dest=_dest(flag), action="store_true", help=text)
             continue
         kind = _typed(spec.parse) if spec.parse else (int if spec.integer else float if spec.choices is None and (
             spec.low is not None or spec.high is not None or is_number(f.default)) else str)
+        if spec.optional or f.default is None:  # "none" (any case) is None, as the help offers
+            kind = _or_none(kind)
         default = None if spec.repeat else f.default
         default = default.value if isinstance(default, Enum) else default
         parser.add_argument(flag, dest=_dest(flag), type=kind, default=default, choices=spec.choices,
                             action="append" if spec.repeat else "store", metavar=spec.metavar,
                             help=text + ("" if default in (None, "") else f" (default {default})"))
     del argparse
+
+
+def _or_none(kind: Callable) -> Callable:
+    """``kind``, with the text ``none`` (any case) read as None (an optional option left unset)."""
+
+    def or_none(text):
+        return None if text.strip().lower() == "none" else kind(text)
+
+    or_none.__name__ = getattr(kind, "__name__", "value")
+    return or_none
 
 
 def _typed(parse: Callable) -> Callable:
@@ -345,7 +407,11 @@ def from_arguments(record: type, args, *, name: str | None = None, **extra):
             if not (spec.repeat and value is None):
                 values[f.name] = value
     values.update(extra)
-    return record.of(None, values, name=name)
+    token = _LABELS.set(cli_flags(record))  # the messages name the flags the user typed
+    try:
+        return record.of(None, values, name=name)
+    finally:
+        _LABELS.reset(token)
 
 
 def cli_flags(record: type) -> dict:

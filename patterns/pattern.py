@@ -21,6 +21,7 @@ from .mesh import polyline_arc
 from .model import Model, Panel, Seam, SurfaceKind
 from .options import check_number
 from .predicates import Overlap, flat_polygon
+from .text import counted
 
 __all__ = ["Dart", "FlatPanel", "FlatSeam", "Flattening", "Pattern"]
 
@@ -485,4 +486,5 @@ class Pattern:
         return replace(self, panels=tuple(panels), laid_out=True)
 
     def __repr__(self) -> str:
-        return f"Pattern({self.name!r}, {len(self.panels)} panels, {len(self.seams)} seams, method={self.method!r})"
+        return (f"Pattern({self.name!r}, {counted(len(self.panels), 'panel')}, {counted(len(self.seams), 'seam')}, "
+                f"method={self.method!r})")

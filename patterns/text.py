@@ -14,12 +14,13 @@ from __future__ import annotations
 import os
 import re
 
-__all__ = ["printable"]
+__all__ = ["counted", "escape", "printable"]
 
 _UNSAFE = re.compile(r"[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
 
 
-def _escape(match: re.Match) -> str:
+def escape(match: re.Match) -> str:
+    """The visible escape of one matched character (``\\x1b``, ``\\xff`` for an undecodable byte, ``\\u2028``)."""
     ch = match.group(0)
     code = ord(ch)
     if 0xDC80 <= code <= 0xDCFF:  # an undecodable byte, as os.fsdecode keeps it
@@ -39,4 +40,20 @@ def printable(text) -> str:
     """
     if not isinstance(text, str):
         text = os.fsdecode(text)
-    return _UNSAFE.sub(_escape, text)
+    return _UNSAFE.sub(escape, text)
+
+
+_IRREGULAR = {"vertex": "vertices", "copy": "copies", "process": "processes", "patch": "patches"}
+
+
+def counted(n: int, noun: str) -> str:
+    """``n`` and ``noun``, plural unless ``n`` is 1: ``"1 panel"``, ``"2 panels"``, ``"1 vertex"``.
+
+    Examples
+    --------
+    >>> counted(1, "dart"), counted(14, "dart"), counted(0, "finding"), counted(3, "vertex")
+    ('1 dart', '14 darts', '0 findings', '3 vertices')
+    """
+    if n == 1:
+        return f"{n} {noun}"
+    return f"{n} {_IRREGULAR.get(noun, noun + 'es' if noun.endswith(('s', 'x', 'ch', 'sh')) else noun + 's')}"

@@ -45,6 +45,7 @@ def test_flatten_a_step_file_writes_the_pattern_report_and_pictures(tmp_path):
     assert "<svg" in (tmp_path / "heat.svg").read_text()
 
 
+@pytest.mark.slow
 def test_flatten_a_mesh_matches_the_library(tmp_path):
     out = tmp_path / "dish.dxf"
     proc = run("flatten", SAMPLES / "dish.obj", "-o", out)
@@ -70,6 +71,7 @@ def test_flatten_developable_sample_to_obj_is_exact(tmp_path):
     assert np.abs(l2 / l3 - 1).max() < 1e-9
 
 
+@pytest.mark.slow
 def test_flatten_astm_profile(tmp_path):
     out = tmp_path / "cup.dxf"
     proc = run("flatten", SAMPLES / "cup.step", "-o", out, "--profile", "astm")
@@ -78,6 +80,7 @@ def test_flatten_astm_profile(tmp_path):
     assert len(doc.modelspace().query("INSERT")) == 4
 
 
+@pytest.mark.slow
 def test_a_failed_strain_check_exits_1_and_still_writes(tmp_path):
     out = tmp_path / "cup.dxf"
     proc = run("flatten", SAMPLES / "cup.step", "-o", out, "--max-strain", "0.03")
@@ -88,6 +91,7 @@ def test_a_failed_strain_check_exits_1_and_still_writes(tmp_path):
     assert ok.returncode == 0, ok.stdout + ok.stderr
 
 
+@pytest.mark.slow
 def test_check_reports_without_writing_a_pattern(tmp_path):
     proc = run("check", SAMPLES / "cup.step", "--max-strain", "0.03", "--report", tmp_path / "r.json")
     assert proc.returncode == 1
@@ -145,6 +149,7 @@ def _batch_folder(folder: Path, n_good: int = 20) -> list[str]:
     return names
 
 
+@pytest.mark.slow
 def test_batch_keeps_going_past_broken_files(tmp_path):
     names = _batch_folder(tmp_path / "in")
     proc = run("batch", tmp_path / "in", "-o", tmp_path / "out", "--jobs", "2", timeout=900)
@@ -160,6 +165,7 @@ def test_batch_keeps_going_past_broken_files(tmp_path):
     assert not (tmp_path / "out" / "broken.dxf").exists()
 
 
+@pytest.mark.slow
 def test_batch_on_a_local_dask_cluster(tmp_path):
     distributed = pytest.importorskip("distributed", reason="Dask is the optional extra patterns[dask]")
     names = _batch_folder(tmp_path / "in", n_good=4)
@@ -173,6 +179,7 @@ def test_batch_on_a_local_dask_cluster(tmp_path):
         assert (tmp_path / "out" / Path(name).with_suffix(".dxf").name).exists()
 
 
+@pytest.mark.slow
 def test_batch_exit_codes(tmp_path):
     folder = tmp_path / "in"
     folder.mkdir()
@@ -195,9 +202,9 @@ def test_batch_exit_codes(tmp_path):
         (("flatten", SAMPLES / "dish.obj", "-o", "x.pdf"), "x.pdf: -o writes .dxf, .svg or .obj, not '.pdf'"),
         (("flatten", SAMPLES / "dish.obj", "-o", "nofolder/x.dxf"), "folder nofolder does not exist"),
         (("flatten", SAMPLES / "cup.step", "-o", "x.obj"), "4 panels; a flat .obj holds one"),
-        (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--max-edge", "-1"), "max_edge"),
-        (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--seam-allowance", "-2"), "seam_allowance"),
-        (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--max-strain", "0"), "max_strain"),
+        (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--max-edge", "-1"), "--max-edge must be"),
+        (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--seam-allowance", "-2"), "--seam-allowance (mm) must be"),
+        (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--max-strain", "0"), "--max-strain must be a ratio"),
         (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--preview", "x.jpg"), "--preview writes .png or .svg"),
         (("check", "part.xyz"), "part.xyz: unknown file type '.xyz'"),
         (("info", "missing.iges"), "no such file"),
@@ -242,14 +249,14 @@ def test_relaxed_is_the_default(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "flattened (relaxed)" in proc.stdout
     bad = run("flatten", SAMPLES / "dish.obj", "-o", tmp_path / "b.dxf", "--max-iterations", "0")
-    assert bad.returncode == 2 and "max_iterations" in bad.stderr
+    assert bad.returncode == 2 and "--max-iterations must be" in bad.stderr
     assert not (tmp_path / "b.dxf").exists()
 
 
 def test_progress_bar_only_on_a_terminal(capsys):
     import io
 
-    from patterns.cli import Progress
+    from patterns.terminal import Progress
 
     stream = io.StringIO()
     bar = Progress("work", stream=stream)  # a StringIO is not a terminal
@@ -275,6 +282,7 @@ def test_sheet_metal_options(tmp_path):
     assert len(doc.modelspace().query('LINE[layer=="BEND"]')) == 15
 
 
+@pytest.mark.slow
 def test_garment_options(tmp_path):
     out = tmp_path / "cup.dxf"
     proc = run("flatten", SAMPLES / "cup.step", "-o", out, "--grain", "0,0,1", "--notch-spacing", "20",
@@ -307,6 +315,7 @@ def test_a_closed_pipe_does_not_stop_the_files_or_show_a_traceback(tmp_path):
     assert json.loads((tmp_path / "dish.json").read_text())["panels"][0]["one_to_one"]
 
 
+@pytest.mark.slow
 def test_energy_and_min_stretch_options(tmp_path):
     """--energy arap presses part of a head flat (its least-strain layout would fold);
     --min-stretch 0.3 keeps every triangle open; the default (auto) goes on with the hybrid."""
@@ -328,12 +337,13 @@ def test_energy_and_min_stretch_options(tmp_path):
     assert strain["arap"] < 1e-3  # a triangle pressed (nearly) flat
     assert strain["guarded"] > 0.25 and strain["auto"] > 0.1  # none below about 0.3 (0.1) of its size
     proc = run("flatten", path, "-o", tmp_path / "bad.dxf", "--min-stretch", "1.5")
-    assert proc.returncode == 2 and "min_stretch" in proc.stderr and "Traceback" not in proc.stderr
+    assert proc.returncode == 2 and "--min-stretch must be" in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "bad.dxf").exists()
 
 
 
 
+@pytest.mark.slow
 def test_seams_and_ease_from_the_command_line(tmp_path):
     lengths = {}
     for label, extra in (("true", ()), ("free", ("--seams", "free")), ("eased", ("--ease", "0:face0:5"))):
@@ -352,3 +362,58 @@ def test_seams_and_ease_from_the_command_line(tmp_path):
         proc = run("flatten", SAMPLES / "cup.step", "-o", out, *bad)
         assert proc.returncode == 2 and words in proc.stderr and "Traceback" not in proc.stderr
         assert not out.exists()
+
+
+def test_each_duration_says_what_it_covers_and_a_kept_marker_says_so(tmp_path, capsys, monkeypatch):
+    """Issue 34: "flattened in 10.85 s" counted the nest, and a cached marker said "(sparrow, 0.0 s)"."""
+    from patterns import cli
+
+    monkeypatch.setenv("PATTERNS_CACHE", str(tmp_path / "cache"))
+    argv = ["flatten", str(SAMPLES / "cup.step"), "-o", str(tmp_path / "cup.dxf"), "--roll-width", "600",
+            "--nest-time", "2"]
+    import time
+
+    start = time.perf_counter()
+    assert cli.main(argv) == 0
+    wall = time.perf_counter() - start
+    first = capsys.readouterr().out
+    flat = float(re.search(r"flattened \(relaxed\) in ([\d.]+) s \(the flattening alone\)", first).group(1))
+    searched = float(re.search(r"nested on a 600 mm roll: .* \(sparrow searched ([\d.]+) s\)", first).group(1))
+    assert flat + searched <= wall + 0.01  # two parts of the run, neither counted in the other
+    assert cli.main(argv) == 0
+    again = capsys.readouterr().out
+    assert re.search(r"nested on a 600 mm roll: .* \(a marker kept from an earlier run with the same pieces and "
+                     r"options, [\d.]+ s; --no-nest-cache searches anew\)", again), again
+    assert cli.main([*argv, "--no-nest-cache"]) == 0
+    assert "(sparrow searched" in capsys.readouterr().out
+
+
+def test_counts_are_singular_for_one():
+    from patterns.text import counted
+
+    assert [counted(n, "panel") for n in (0, 1, 2)] == ["0 panels", "1 panel", "2 panels"]
+    assert counted(1, "vertex") == "1 vertex" and counted(2, "vertex") == "2 vertices"
+    assert counted(1, "process") == "1 process" and counted(4, "process") == "4 processes"
+    model = patterns.load(SAMPLES / "cone.obj")
+    assert ", 1 panel, 0 seams, " in repr(model)
+    assert "(1 panel, 0 seams, " in str(patterns.check(patterns.flatten(model)))
+
+
+def test_one_panel_and_one_bend_read_in_the_singular(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "patterns", "info", str(SAMPLES / "cone.obj")], capture_output=True,
+                          text=True, timeout=120, check=False)
+    assert proc.returncode == 0 and "cone.obj: 1 panel, 0 seams (" in proc.stdout, proc.stdout + proc.stderr
+    proc = subprocess.run([sys.executable, "-m", "patterns", "unfold", str(SAMPLES / "bracket.step"), "-o",
+                           str(tmp_path / "l.dxf")], capture_output=True, text=True, timeout=120, check=False)
+    assert proc.returncode == 0 and ": sheet 2 mm, 1 bend, 1 hole; blank " in proc.stdout, proc.stdout + proc.stderr
+
+
+def test_a_pattern_is_never_written_under_a_suffix_of_another_format(tmp_path):
+    """Issue 34: Pattern.to_dxf("x.pdf") wrote a DXF named x.pdf; patterns.write takes its format from the suffix
+    and refuses one it cannot write, writing nothing."""
+    pattern = patterns.flatten(patterns.load(SAMPLES / "cone.obj"))
+    for name in ("x.pdf", "x.DXF.pdf", "x", "x.png"):
+        with pytest.raises(patterns.InputError, match=r"cannot write '(\.pdf|\.png|\(no suffix\))' files; "
+                                                      r"write \.dxf, \.json, \.svg"):
+            patterns.write(pattern, tmp_path / name)
+    assert not list(tmp_path.iterdir())

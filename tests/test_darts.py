@@ -58,6 +58,7 @@ def hemisphere():
     return model, patterns.flatten(model, max_strain=LIMIT)
 
 
+@pytest.mark.slow
 def test_a_hemisphere_gets_a_few_long_darts_within_the_limit(hemisphere):
     model, pattern = hemisphere
     (flat,) = pattern.panels
@@ -162,6 +163,7 @@ def test_the_report_and_the_dxf_list_every_dart(hemisphere, tmp_path):
     assert len(points) == len(flat.darts)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("source", ["cup", "four gores"])
 def test_every_panel_of_a_dome_in_gores_meets_the_limit_and_its_seams_stay_true(source):
     if source == "cup":
@@ -185,6 +187,7 @@ def test_every_panel_of_a_dome_in_gores_meets_the_limit_and_its_seams_stay_true(
     assert patterns.check(pattern).ok
 
 
+@pytest.mark.slow
 def test_a_looser_limit_takes_fewer_darts_and_too_few_darts_are_reported(hemisphere):
     model, pattern = hemisphere
     loose = patterns.flatten(model, max_strain=0.06)
@@ -198,6 +201,7 @@ def test_a_looser_limit_takes_fewer_darts_and_too_few_darts_are_reported(hemisph
     assert any(f.code is patterns.Code.STRAIN_ABOVE_LIMIT for f in report.findings)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("source, cuts", [("hemisphere", 16), ("cup", 12)])
 def test_gores_split_a_dome_into_pieces_that_each_meet_the_limit(hemisphere, source, cuts, tmp_path):
     model = hemisphere[0] if source == "hemisphere" else patterns.load(SAMPLES / "cup.step")
@@ -227,6 +231,7 @@ def cup_darts():
     return patterns.flatten(patterns.load(SAMPLES / "cup.step"), max_strain=LIMIT)
 
 
+@pytest.mark.slow
 def test_real_readers_read_the_darted_pattern(cup_darts, tmp_path):
     """dxf2gcode chains one closed contour per panel (the outline running into every dart),
     FreeCAD the same closed wires, each with the outline's own area and length."""

@@ -29,6 +29,7 @@ from patterns import cli, surfaces
 from .conftest import SAMPLES
 
 distributed = pytest.importorskip("distributed", reason="Dask is the optional extra patterns[dask]")
+pytestmark = pytest.mark.slow  # a real Dask scheduler and workers: run by .ci/run (pytest -m slow), not the quick suite
 PYTHON = sys.executable
 NOPATTERNS = """
 import sys
@@ -38,6 +39,7 @@ class _Block:
             raise ModuleNotFoundError(f"No module named {name!r}")
 sys.meta_path.insert(0, _Block())
 from dask.cli import run_cli
+
 sys.argv = ["dask", *sys.argv[1:]]
 run_cli()
 """
@@ -200,7 +202,7 @@ def test_a_part_that_kills_its_worker_is_one_row_lost(client_folder, cluster, ca
 def test_bad_and_unreachable_addresses_are_one_line(client_folder, capfd, address, words):
     start = time.perf_counter()
     code, out, err = _batch(["batch", "parts", "-o", "out", "--scheduler", address], client_folder, capfd)
-    assert time.perf_counter() - start < 5.0
+    assert time.perf_counter() - start < 60  # a guard against a hang, not a measure of speed
     assert code == 2 and err.strip().count("\n") == 0 and words in err, err
     assert not (client_folder / "out").exists()
 

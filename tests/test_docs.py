@@ -1,9 +1,10 @@
-"""Every code block of README.md and docs/*.md runs, so the documentation cannot go stale.
+"""Every code block of README.md and docs/*.md runs, and every value its comments show is compared.
 
 Python blocks of one file run in order in one namespace, in a fresh folder where
-``samples/`` is the repository's; those of docs/freecad.md run so inside FreeCAD (``freecadcmd``, this
-interpreter's packages in front of its path, as that page has a user do), skipped where FreeCAD is
-absent.  Shell blocks run their ``patterns`` commands
+``samples/`` is the repository's (a block run alone, with ``-k`` or on another xdist worker,
+first runs the file's earlier Python blocks); those of docs/freecad.md run so inside FreeCAD
+(``freecadcmd``, this interpreter's packages in front of its path, as that page has a user do),
+skipped where FreeCAD is absent.  Shell blocks run their ``patterns`` commands
 with this interpreter's entry point and must exit 0 (or the code a ``# exit N``
 comment gives).  JSON blocks must parse.  A block that cannot run in a test
 says so in the markdown, on the line just before its fence::
@@ -12,16 +13,39 @@ says so in the markdown, on the line just before its fence::
 
 and is reported as skipped with that reason.  ``<!-- test: slow -->`` marks a
 long block with the ``slow`` marker.
+
+**Values the comments show.**  In a Python block, a comment after the code of a line is a
+*value* when it begins with a Python literal -- a number, a quote, ``[``, ``(``, ``{``, ``True``,
+``False``, ``None`` -- or with a repr such as ``Model(`` (a capitalised name and a parenthesis);
+any other comment is prose (``# or "part.step"``, ``# every panel flat, 1:1``, ``# about 3 s``).
+The line's value is compared with it as the line runs (in a loop, the first time): an
+expression's value, an assignment's assigned value, a ``print``'s arguments (the comment shows
+them separated by spaces, as ``print`` writes them).  A number is compared to the digits it
+shows (``328.0901`` means ``round(x, 4) == 328.0901``); ``...`` is a wildcard in a list, a
+tuple, a string or a repr (whose text is matched against ``repr()``, ``str()`` for a ``print``'s
+argument, numbers again to their digits); after the value may come a unit (``mm``, ``mm²``, ``%``, ``s``, ``°``) and then
+prose after ``:``, ``;`` or ``,``.  A value comment the test cannot read fails, so a value
+that cannot be compared exactly (a time, a nest's length after a time budget) is written as
+prose: ``# about 3 s``, ``# a 900 mm roll: about 450 mm used``.  In a shell block written as
+a transcript, the lines after a ``$ patterns ...`` line are its output: each is matched
+against the command's output lines (stdout and stderr, in order) the same way, a line ``...``
+standing for any number of lines.
 """
 
 from __future__ import annotations
 
+import ast
+import io
 import json
+import numbers
 import os
 import re
 import shlex
 import subprocess
 import sys
+import tokenize
+import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -54,25 +78,380 @@ def _blocks(path: Path):
 def _cases():
     for path in FILES:
         for line, lang, code, mark, reason in _blocks(path):
-            marks = [pytest.mark.slow] if mark == "slow" else []
+            # one worker runs a file's blocks, in order (pytest -n with --dist loadgroup, as pyproject sets):
+            # each block builds on the ones before it, which another worker would run again
+            marks = [pytest.mark.xdist_group(path.name)] + ([pytest.mark.slow] if mark == "slow" else [])
             if mark == "skip":
                 marks.append(pytest.mark.skip(reason=reason or "marked skip in the markdown"))
             yield pytest.param(path, line, lang, code, id=f"{path.relative_to(REPO)}:{line}", marks=marks)
 
 
+# --------------------------------------------------------------------------- #
+# Values the comments show (the convention is in the module's docstring)
+# --------------------------------------------------------------------------- #
+
+_VALUE = re.compile(r"""[-+]?\.?\d|['"\[({]|(?:True|False|None)(?!\w)|[A-Z]\w*\(""")
+_REPR = re.compile(r"[A-Z]\w*\(")
+_UNIT = re.compile(r"\s*(?:mm²|mm2|mm|cm|m|in|%|s|°)(?![\w²])")
+_NUMBER = r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
+
+
+@dataclass(frozen=True)
+class _Number:
+    """A number as a comment shows it: compared to the digits of ``text``."""
+
+    text: str
+
+    def __repr__(self):
+        return self.text
+
+
+@dataclass(frozen=True)
+class _Text:
+    """A repr as a comment shows it (``Model('cup.step', 4 panels, ...)``): matched against the value's text."""
+
+    text: str
+
+    def __repr__(self):
+        return self.text
+
+
+def _same_number(actual, text: str) -> bool:
+    mantissa, _, exponent = text.lower().partition("e")
+    digits = len(mantissa.partition(".")[2]) - int(exponent or 0)
+    return round(float(actual), digits) == float(text)
+
+
+def _literal(node, source: str):
+    """The value a literal's syntax tree shows: numbers as :class:`_Number`, ``...`` as Ellipsis."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
+        return _Number(ast.get_source_segment(source, node))
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)) and \
+            isinstance(node.operand, ast.Constant) and isinstance(node.operand.value, (int, float)):
+        return _Number(ast.get_source_segment(source, node).replace(" ", ""))
+    if isinstance(node, ast.Constant) and (node.value in (True, False, None, ...) or isinstance(node.value, str)):
+        return node.value
+    if isinstance(node, (ast.Tuple, ast.List)):
+        items = [_literal(e, source) for e in node.elts]
+        return tuple(items) if isinstance(node, ast.Tuple) else items
+    if isinstance(node, ast.Dict) and None not in node.keys:
+        return {ast.literal_eval(k): _literal(v, source) for k, v in zip(node.keys, node.values)}
+    raise ValueError("not a literal")
+
+
+def _one_value(text: str):
+    """The value at the start of ``text`` and what follows it: the longest Python literal, or a repr."""
+    if _REPR.match(text):
+        depth, quote = 0, None
+        for end, c in enumerate(text):
+            if quote:
+                quote = None if c == quote else quote
+            elif c in "'\"":
+                quote = c
+            elif c in "([{":
+                depth += 1
+            elif c in ")]}":
+                depth -= 1
+                if depth == 0:
+                    return _Text(text[:end + 1]), text[end + 1:]
+        raise ValueError(f"the repr {text!r} is not closed")
+    for end in range(len(text), 0, -1):
+        chunk = text[:end]
+        if chunk[-1].isspace() or chunk[-1] == ",":
+            continue
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                node = ast.parse(chunk, mode="eval").body
+            return _literal(node, chunk), text[end:]
+        except (SyntaxError, ValueError):
+            continue
+    raise ValueError(f"{text!r} does not begin with a Python literal")
+
+
+def shown_values(comment: str, many: bool = False):
+    """The values a comment shows (a list: one, or a ``print``'s several), or None if it is prose.
+
+    Raises ValueError for a comment that begins like a value but cannot be read as one."""
+    text = comment.lstrip("#").strip()
+    if not _VALUE.match(text):
+        return None
+    values, rest = [], text
+    while True:
+        value, rest = _one_value(rest)
+        values.append(value)
+        if not (many and _VALUE.match(rest.lstrip())):
+            break
+        rest = rest.lstrip()
+    if unit := _UNIT.match(rest):
+        rest = rest[unit.end():]
+    if rest.strip() and not rest.lstrip().startswith((":", ";", ",")):
+        raise ValueError(f"after the value {text[:len(text) - len(rest)].strip()!r} comes {rest.strip()!r}: "
+                         f"a value comment goes on after ':', ';' or ',' (or write it as prose)")
+    return values
+
+
+def _plain(actual):
+    """numpy scalars and arrays as Python's (an array matches a shown list or tuple)."""
+    if hasattr(actual, "tolist") and not isinstance(actual, (str, bytes)):
+        return actual.tolist(), hasattr(actual, "shape") and actual.shape != ()
+    return actual, False
+
+
+def _text_mismatch(shown: str, text: str) -> str | None:
+    """Why ``text`` is not what ``shown`` shows (``...`` any text, numbers to their digits), or None."""
+    parts = [p for p in re.split(rf"(\.\.\.|{_NUMBER})", shown) if p]
+    pattern = "".join("(.*?)" if p == "..." else f"({_NUMBER})" if re.fullmatch(_NUMBER, p) else re.escape(p)
+                      for p in parts)
+    m = re.fullmatch(pattern, text, re.DOTALL)
+    if m is None:
+        return f"the text is {text!r}"
+    holes = [p for p in parts if p == "..." or re.fullmatch(_NUMBER, p)]
+    wrong = [f"{got} is not {want}" for want, got in zip(holes, m.groups())
+             if want != "..." and not _same_number(got, want)]
+    return "; ".join(wrong) or None
+
+
+def _mismatch(shown, actual, text_of=repr) -> str | None:
+    """Why ``actual`` is not the value ``shown`` (from :func:`shown_values`), or None if it is."""
+    actual, array = _plain(actual)
+    if shown is ...:
+        return None
+    if isinstance(shown, _Number):
+        if isinstance(actual, bool) or not isinstance(actual, numbers.Real):
+            return f"{actual!r} is not a number"
+        return None if _same_number(actual, shown.text) else f"{actual!r} is not {shown.text}"
+    if isinstance(shown, _Text):
+        return _text_mismatch(shown.text, text_of(actual))
+    if shown is None or isinstance(shown, bool):
+        return None if actual is shown else f"{actual!r} is not {shown!r}"
+    if isinstance(shown, str):
+        if not isinstance(actual, str):
+            return f"{actual!r} is not a string"
+        pattern = ".*".join(re.escape(p) for p in shown.split("..."))
+        return None if re.fullmatch(pattern, actual, re.DOTALL) else f"{actual!r} is not {shown!r}"
+    if isinstance(shown, dict):
+        if not isinstance(actual, dict) or set(actual) != set(shown):
+            return f"{actual!r} is not a dict with the keys {sorted(shown)}"
+        return next((f"[{k!r}]: {w}" for k in shown if (w := _mismatch(shown[k], actual[k]))), None)
+    if not (array and isinstance(actual, list)) and type(shown) is not type(actual) and \
+            not (isinstance(shown, tuple) and isinstance(actual, tuple)):
+        return f"{actual!r} is a {type(actual).__name__}, not a {type(shown).__name__}"
+    return _items_mismatch(list(shown), list(actual))
+
+
+def _items_mismatch(shown: list, actual: list) -> str | None:
+    if not shown:
+        return None if not actual else f"{len(actual)} more items than shown"
+    if shown[0] is ...:
+        rest = shown[1:]
+        if any(_items_mismatch(rest, actual[k:]) is None for k in range(len(actual) + 1)):
+            return None
+        return f"no run of items ends as shown: {rest!r}"
+    if not actual:
+        return "fewer items than shown"
+    return _mismatch(shown[0], actual[0]) or _items_mismatch(shown[1:], actual[1:])
+
+
+def _value_comments(code: str) -> dict[int, str]:
+    """``{line: comment}`` of every comment after code on its line (line 1 the block's first)."""
+    found = {}
+    for tok in tokenize.generate_tokens(io.StringIO(code).readline):
+        if tok.type == tokenize.COMMENT and tok.line[:tok.start[1]].strip():
+            found[tok.start[0]] = tok.string
+    return found
+
+
+def _checked_lines(code: str, filename: str, first_line: int):
+    """The block's syntax tree and ``{line: (statement, kind, shown values, comment)}`` of its value comments.
+
+    ``kind`` is ``"print"``, ``"value"`` (an expression) or ``"assign"``.  Raises ValueError naming the
+    line of a value comment that cannot be read or sits where no value can be taken."""
+    tree = ast.parse(code, f"{filename}:{first_line}")
+    simple = [n for n in ast.walk(tree) if isinstance(n, ast.stmt) and not hasattr(n, "body")]
+    checks = {}
+    for line, comment in _value_comments(code).items():
+        stmt = max((s for s in simple if s.lineno <= line <= s.end_lineno), default=None,
+                   key=lambda s: (s.lineno, s.col_offset))  # the last on the line
+        is_print = isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Call) and \
+            isinstance(stmt.value.func, ast.Name) and stmt.value.func.id == "print"
+        where = f"{filename}:{first_line + line}"
+        try:
+            values = shown_values(comment, many=is_print)
+        except ValueError as exc:
+            raise ValueError(f"{where}: {comment!r}: {exc}") from None
+        if values is None:
+            continue
+        kind = "print" if is_print else "value" if isinstance(stmt, ast.Expr) else \
+            "assign" if isinstance(stmt, (ast.Assign, ast.AnnAssign)) and stmt.value is not None else None
+        if kind is None:
+            raise ValueError(f"{where}: {comment!r} shows a value on a line that has none "
+                             f"(write it as prose)")
+        if any(c[0] is stmt for c in checks.values()):
+            raise ValueError(f"{where}: a second value comment on one statement")
+        if kind != "print" and len(values) != 1:
+            raise ValueError(f"{where}: {comment!r}: one value expected")
+        checks[line] = (stmt, kind, values, comment)
+    return tree, checks
+
+
+class _Values:
+    """The comparisons of one block, called from its instrumented code."""
+
+    def __init__(self, checks, lines, where):
+        self.checks, self.lines, self.where = checks, lines, where
+        self.done, self.wrong = set(), []
+
+    def _compare(self, line, actual, text_of):
+        if line in self.done:
+            return
+        self.done.add(line)
+        _, _, values, comment = self.checks[line]
+        if len(values) != len(actual):
+            why = f"it prints {len(actual)} values, the comment shows {len(values)}"
+        else:
+            why = next((w for v, a in zip(values, actual) if (w := _mismatch(v, a, text_of))), None)
+        if why:
+            shown = " ".join(map(repr, actual)) if text_of is str else repr(actual[0])
+            self.wrong.append(f"{self.where(line)}: `{self.lines[line - 1].strip()}`\n"
+                              f"    shows {comment.lstrip('#').strip()}\n    but   {shown}\n    ({why})")
+
+    def value(self, line, actual):
+        self._compare(line, [actual], repr)
+        return actual
+
+    def print(self, line, *args, **keywords):
+        print(*args, **keywords)
+        self._compare(line, list(args), str)
+
+    def verdict(self):
+        missed = [self.where(line) for line in self.checks if line not in self.done]
+        if self.wrong:
+            raise AssertionError("values that are not what the comments show:\n" + "\n".join(self.wrong))
+        if missed:
+            raise AssertionError(f"value comments on lines that never ran: {missed}")
+
+
+class _Instrument(ast.NodeTransformer):
+    """Passes the value of every checked line through ``__doc_values__``."""
+
+    def __init__(self, checks):
+        self.by_stmt = {id(stmt): (line, kind) for line, (stmt, kind, _, _) in checks.items()}
+
+    def _call(self, method, line, args, keywords=(), at=None):
+        func = ast.Attribute(ast.Name("__doc_values__", ast.Load()), method, ast.Load())
+        return ast.copy_location(ast.Call(func, [ast.Constant(line), *args], list(keywords)), at)
+
+    def generic_visit(self, node):
+        node = super().generic_visit(node)
+        if (found := self.by_stmt.get(id(node))) is None:
+            return node
+        line, kind = found
+        if kind == "print":
+            node.value = self._call("print", line, node.value.args, node.value.keywords, node.value)
+        else:
+            node.value = self._call("value", line, [node.value], at=node.value)
+        return node
+
+
+def run_python_block(namespace: dict, code: str, filename: str, first_line: int) -> int:
+    """Run one Python block of a markdown file in ``namespace``, comparing every value its comments show
+    with the value of its line; return how many were compared.  ``first_line``: the markdown line of the
+    fence.  (Also called inside FreeCAD, by the code :func:`_freecad_block` writes.)"""
+    name = f"{filename}:{first_line}"
+    tree, checks = _checked_lines(code, filename, first_line)
+    tree = ast.fix_missing_locations(_Instrument(checks).visit(tree))
+    values = _Values(checks, code.splitlines(), lambda line: f"{filename}:{first_line + line}")
+    namespace["__doc_values__"] = values
+    exec(compile(tree, name, "exec"), namespace)  # noqa: S102 - the docs' own code
+    values.verdict()
+    return len(checks)
+
+
+def _freecad_block(code: str, line: int) -> str:
+    """The code freecadcmd runs for one block of docs/freecad.md: :func:`run_python_block` on it, from this file."""
+    return (f"if '__doc_run__' not in globals():\n"
+            f"    import importlib.util as _u\n"
+            f"    _spec = _u.spec_from_file_location('patterns_doc_values', {str(Path(__file__))!r})\n"
+            f"    _m = _u.module_from_spec(_spec)\n"
+            f"    __import__('sys').modules[_spec.name] = _m\n"
+            f"    _spec.loader.exec_module(_m)\n"
+            f"    __doc_run__ = _m.run_python_block\n"
+            f"__doc_run__(globals(), {code!r}, 'freecad.md', {line})\n")
+
+
+def _transcript(code: str):
+    """``[(command, shown output lines or None)]`` of a shell block: a transcript's ``$`` lines and the lines
+    after each; or every line a command when no line starts with ``$ ``."""
+    lines = [x.rstrip() for x in code.splitlines()]
+    if not any(x.startswith("$ ") for x in lines):
+        return [(c, None) for c in (x.strip() for x in lines) if c and not c.startswith("#")]
+    out = []
+    for x in lines:
+        if x.startswith("$ "):
+            out.append((x[2:].strip(), []))
+        elif out and x:
+            out[-1][1].append(x)
+    return [(c, shown or None) for c, shown in out]
+
+
+def _output_mismatch(shown: list[str], lines: list[str]) -> str | None:
+    """Why the output ``lines`` are not the ``shown`` ones (a line ``...``: any number of lines), or None."""
+    if not shown:
+        return None if not lines else f"{len(lines)} more lines than shown, from {lines[0]!r}"
+    if shown[0].strip() == "...":
+        rest = shown[1:]
+        if not rest:
+            return None
+        if rest[0].strip() == "...":
+            return _output_mismatch(rest, lines)
+        starts = [k for k in range(len(lines)) if _text_mismatch(rest[0], lines[k]) is None]
+        if not starts:
+            return f"no output line is {rest[0]!r}"
+        whys = [_output_mismatch(rest, lines[k:]) for k in starts]
+        return None if None in whys else whys[0]
+    if not lines:
+        return f"the output ends before {shown[0]!r}"
+    if (why := _text_mismatch(shown[0], lines[0])) is not None:
+        return f"{shown[0]!r}: {why}"
+    return _output_mismatch(shown[1:], lines[1:])
+
+
 @pytest.fixture(scope="module")
 def workdirs(tmp_path_factory):
-    """One working folder and one namespace per markdown file."""
+    """One working folder, one namespace and the lines of the Python blocks run so far, per markdown file."""
     made = {}
 
     def get(path):
         if path not in made:
             folder = tmp_path_factory.mktemp(path.stem)
             (folder / "samples").symlink_to(REPO / "samples")
-            made[path] = (folder, {"__name__": "__docs__"})
+            made[path] = (folder, {"__name__": "__docs__"}, set())
         return made[path]
 
     return get
+
+
+def _python_up_to(path: Path, line: int, workdirs) -> None:
+    """Run the Python blocks of ``path`` up to the one at ``line`` that have not run in this process, in
+    order: a block run alone (``-k``, another xdist worker) finds what the earlier blocks made."""
+    folder, namespace, ran = workdirs(path)
+    for start, lang, code, mark, _ in _blocks(path):
+        if start > line:
+            break
+        if lang != "python" or mark == "skip" or start in ran:
+            continue
+        ran.add(start)
+        old = Path.cwd()
+        os.chdir(folder)
+        try:
+            run_python_block(namespace, code, path.name, start)
+        except Exception as exc:
+            if start == line:
+                raise
+            pytest.fail(f"the earlier block at {path.name}:{start}, run first, fails:\n{exc}")
+        finally:
+            os.chdir(old)
 
 
 def _patterns_command() -> list[str]:
@@ -96,7 +475,8 @@ def freecad_blocks(tmp_path_factory):
         pytest.skip("FreeCAD is not installed (.ci/run installs it with apt-get)")
     folder = tmp_path_factory.mktemp("freecad-docs")
     (folder / "samples").symlink_to(REPO / "samples")
-    blocks = [(line, code) for line, lang, code, mark, _ in _blocks(FREECAD_DOC) if lang == "python" and mark != "skip"]
+    blocks = [(line, _freecad_block(code, line)) for line, lang, code, mark, _ in _blocks(FREECAD_DOC)
+              if lang == "python" and mark != "skip"]
     (folder / "blocks.json").write_text(json.dumps(blocks))
     env = dict(os.environ, PATTERNS_SITE=sysconfig.get_paths()["purelib"], BLOCKS=str(folder / "blocks.json"),
                OUT=str(folder / "out.json"), HOME=str(folder))
@@ -108,34 +488,130 @@ def freecad_blocks(tmp_path_factory):
 
 @pytest.mark.parametrize(("path", "line", "lang", "code"), list(_cases()))
 def test_code_block_runs(path, line, lang, code, workdirs, request):
-    folder, namespace = workdirs(path)
     if lang == "python" and path == FREECAD_DOC:
         result = request.getfixturevalue("freecad_blocks")[str(line)]
         assert result == "ok", result
     elif lang == "python":
-        old = Path.cwd()
-        os.chdir(folder)
-        try:
-            exec(compile(code, f"{path.name}:{line}", "exec"), namespace)  # noqa: S102 - the docs' own code
-        finally:
-            os.chdir(old)
+        _python_up_to(path, line, workdirs)
     elif lang in ("bash", "sh", "console", "shell", ""):
-        commands = [c for c in (x.strip() for x in code.splitlines()) if c and not c.startswith("#")]
-        commands = [c.removeprefix("$ ") for c in commands]
-        runnable = [c for c in commands if c.split()[0] in ("patterns", ".venv/bin/patterns")]
+        runnable = [(c, shown) for c, shown in _transcript(code) if c.split()[0] in ("patterns", ".venv/bin/patterns")]
         if not runnable:
             pytest.skip("no patterns command in this block (output shown, or set-up commands)")
-        for command in runnable:
+        _python_up_to(path, line, workdirs)  # the files the earlier blocks wrote
+        folder = workdirs(path)[0]
+        for command, shown in runnable:
             text, _, comment = command.partition("#")
             want = int(m.group(1)) if (m := re.search(r"exit (?:code )?(\d)", comment)) else 0
             argv = _patterns_command() + shlex.split(text)[1:]
-            proc = subprocess.run(argv, cwd=folder, capture_output=True, text=True, timeout=600)
-            assert proc.returncode == want, f"{command}: exit {proc.returncode}\n{proc.stderr}"
-            assert "Traceback" not in proc.stderr
+            proc = subprocess.run(argv, cwd=folder, stdout=subprocess.PIPE, text=True, timeout=600, check=False,
+                                  stderr=subprocess.STDOUT if shown else subprocess.PIPE)
+            output = proc.stdout + (proc.stderr or "")
+            assert proc.returncode == want, f"{command}: exit {proc.returncode}\n{output[-3000:]}"
+            assert "Traceback" not in output
+            if shown:
+                why = _output_mismatch(shown, proc.stdout.splitlines())
+                assert why is None, f"{path.name}:{line}: `{command}` does not print what the block shows: {why}" \
+                                    f"\n--- it prints:\n{proc.stdout}"
     elif lang == "json":
         json.loads(code)
     else:
         pytest.skip(f"a {lang} block")
+
+
+def _python_blocks():
+    for path in FILES:
+        for line, lang, code, mark, _ in _blocks(path):
+            if lang == "python" and mark != "skip":
+                yield path, line, code
+
+
+def test_every_value_comment_is_read():
+    """Every comment that begins like a value reads as one and sits on a line that has a value."""
+    errors, count = [], 0
+    for path, line, code in _python_blocks():
+        try:
+            count += len(_checked_lines(code, path.name, line)[1])
+        except (ValueError, SyntaxError) as exc:
+            errors.append(str(exc))
+    assert not errors, "\n".join(errors)
+    assert count >= 37, f"only {count} value comments found (37 in issue 34): is the convention still recognised?"
+
+
+@pytest.mark.parametrize(("line", "comment", "right"), [
+    ("x = 328.09012; x", "# 328.0901", True),
+    ("x = 328.09012; x", "# 328.0902", False),
+    ("x = 328.09012; x", "# 328.09 mm", True),
+    ("x = 328.09012; x", "# 328.1 mm²: prose after a colon", True),
+    ("x = 5; x", "# 5.0", True),
+    ("x = True; x", "# 1", False),
+    ("x = 1; x", "# True", False),
+    ("x = [('a', 1.04), ('b', 2.0), ('c', 3.0)]; x", "# [('a', 1.0), ...]", True),
+    ("x = [('a', 1.04), ('b', 2.0), ('c', 3.0)]; x", "# [('a', 1.0), ..., ('c', 3.0)]", True),
+    ("x = [('a', 1.04), ('b', 2.0), ('c', 3.0)]; x", "# [('a', 1.0), ..., ('b', 3.0)]", False),
+    ("x = [1.0, 2.0]; x", "# [1.0]", False),
+    ("x = [1.0, 2.0]; x", "# (1.0, 2.0)", False),
+    ("import numpy as np; x = np.array([1.0, 2.25]); x", "# (1.0, 2.2)", True),
+    ("x = 'panel face0: strain above 3.00% on 84.8% of its area'; x", "# 'panel face0: ... 84.8% ...'", True),
+    ("x = 'panel face0: strain above 3.00% on 84.8% of its area'; x", "# 'panel face1: ...'", False),
+    ("x = (2.0, [100.0, 112.1894]); x", "# 2.0, [100.0, 112.189]: 50 + 2 x 25", True),
+    ("x = 7", "# 7: an assignment's value", True),
+    ("x = 7", "# 8", False),
+    ("print((0, 1), 328.09012, 'one')", "# (0, 1) 328.0901 'one'", True),
+    ("print((0, 1), 328.09012, 'one')", "# (0, 1) 328.0901", False),
+    ("from fractions import Fraction as F; x = F(1, 3); x", "# Fraction(1, 3)", True),
+    ("from fractions import Fraction as F; x = F(1, 3); x", "# Fraction(1, ...)", True),
+    ("from fractions import Fraction as F; x = F(1, 3); x", "# Fraction(2, 3)", False),
+    ("x = 1; x", "# about 1 s", True),  # prose: not compared
+])
+def test_the_value_convention(line, comment, right):
+    """The comparisons the doc tests make, on small blocks: right values pass, a digit off fails."""
+    code = line + "   " + comment
+    if right:
+        run_python_block({}, code, "test.md", 1)
+    else:
+        with pytest.raises(AssertionError, match="not what the comments show"):
+            run_python_block({}, code, "test.md", 1)
+
+
+@pytest.mark.parametrize("comment", ["# 12 pieces, 12 seams", "# (n, 3) mm", "# False if it folds"])
+def test_a_value_comment_that_cannot_be_read_fails(comment):
+    with pytest.raises(ValueError):
+        _checked_lines(f"x = 1; x   {comment}", "test.md", 1)
+
+
+def test_output_lines_are_compared():
+    shown = ["cup.step: NOT ok (4 panels, 4 seams, 4 findings)", "...", "  limit: ... up to 12.47% ..."]
+    out = ["panel  triangles", "cup.step: NOT ok (4 panels, 4 seams, 4 findings)", "  limit: a",
+           "  limit: b, up to 12.4702% at (1, 2) mm", "done"]
+    assert _output_mismatch(shown, out[1:]) is not None  # "done" is not shown
+    assert _output_mismatch([*shown, "..."], out[1:]) is None
+    assert _output_mismatch(["...", *shown, "..."], out) is None
+    assert _output_mismatch(["...", shown[0].replace("4 findings", "5 findings"), "..."], out) is not None
+
+
+@pytest.mark.slow
+def test_the_demo_says_its_limit_and_why(tmp_path):
+    """``patterns demo`` says first the strain limit it checks against, then why the cup exceeds it, and a
+    command that brings the cup within it -- which does (issue 34)."""
+    def run(*argv):
+        return subprocess.run(_patterns_command() + list(argv), cwd=tmp_path, capture_output=True, text=True,
+                              timeout=600, check=False)
+
+    demo = run("demo", "-o", "out")
+    assert demo.returncode == 0, demo.stderr
+    lines = demo.stdout.splitlines()
+    assert "checked against a strain limit of 5 % (as --max-strain 0.05 would)" in lines[0]
+    verdict = lines.index("cup.step: NOT ok (4 panels, 4 seams, 4 findings)")
+    why = next(i for i, x in enumerate(lines) if x.startswith("why: "))
+    assert why > verdict
+    assert "a doubly curved panel cannot lie flat without stretching" in lines[why]
+    assert "up to 12.47 %, above the 5 % limit" in lines[why]
+    argv = shlex.split(lines[why + 1])
+    assert argv[:3] == ["patterns", "flatten", "out/cup.step"] and "--gores" in argv, argv
+    assert argv[argv.index("--max-strain") + 1] == "0.05"
+    within = run(*argv[1:])
+    assert within.returncode == 0, within.stdout + within.stderr
+    assert "cup.step: ok (" in within.stdout
 
 
 @pytest.mark.parametrize("command", ["flatten", "batch", "unfold"])

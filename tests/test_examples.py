@@ -14,6 +14,7 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 READERS = Path(__file__).parent / "readers"
 
 
+@pytest.mark.slow
 def test_build123d_script(tmp_path):
     proc = subprocess.run([sys.executable, str(EXAMPLES / "build123d_part.py"), str(tmp_path)],
                           capture_output=True, text=True, timeout=600)

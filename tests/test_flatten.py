@@ -270,6 +270,7 @@ def test_conformal_diverges_on_a_fine_cap_and_says_so():
     assert not r.one_to_one
 
 
+@pytest.mark.slow
 def test_overflow_is_an_error_not_a_result():
     v, f = surfaces.spherical_cap(radius=100.0, half_angle=60.0, n_faces=400_000)
     try:
@@ -312,6 +313,7 @@ def test_surface_with_holes_flattens_one_to_one():
 # --------------------------------------------------------------------------- corpus
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", corpus_files())
 @pytest.mark.parametrize("method", patterns.METHODS)
 def test_corpus_verdict_is_truthful(path, method):

@@ -24,6 +24,8 @@ import shapely
 import patterns
 from patterns.cli import main
 
+pytestmark = pytest.mark.slow  # the real FreeCAD, started per test: run by .ci/run (pytest -m slow), not the quick suite
+
 REPO = Path(__file__).resolve().parent.parent
 READERS = Path(__file__).resolve().parent / "readers"
 SHEETMETAL = REPO.parent / "shared" / "sheetmetal"

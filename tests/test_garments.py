@@ -86,6 +86,7 @@ def test_matching_notches_are_at_equal_3d_arc_length(cup_pattern, tmp_path):
         patterns.write(cup_pattern, tmp_path / "x.dxf", notch_style="castle")
 
 
+@pytest.mark.slow
 def test_nesting_ten_panels_on_a_roll():
     shape = bd.Compound([cup(), bd.Pos(1000, 0, 0) * duct_transition(), bd.Pos(-2000, 0, 0) * hopper(),
                          bd.Pos(0, 3000, 0) * hull_panel()])
@@ -167,6 +168,7 @@ def test_squared_seam_allowance_corners(cup_pattern, tmp_path):
         patterns.write(laid, tmp_path / "x.dxf", seam_allowance=10.0, seam_corners="round")
 
 
+@pytest.mark.slow
 def test_the_strain_limit_travels_with_the_pattern():
     """flatten(max_strain=...) records its limit; check() judges against it unless told otherwise
     (a darted pattern still above its limit is not called ok by a check without arguments)."""

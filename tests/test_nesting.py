@@ -133,6 +133,7 @@ def test_only_patterns_blanks_and_pieces_are_nested():
         patterns.layout(type("Almost", (), {"panels": (), "name": "x"})(), width=100.0)
 
 
+@pytest.mark.slow
 def test_the_same_pieces_and_options_give_the_same_marker(plates, _marker_cache):
     """Sparrow's search stops on time, so a loaded machine could stop it elsewhere: every marker is kept
     (the cache the suite points PATTERNS_CACHE at), and asked again gives the same marker, at once;
@@ -146,9 +147,9 @@ def test_the_same_pieces_and_options_give_the_same_marker(plates, _marker_cache)
     assert len(kept) == 1
     b = patterns.layout(plates, width=300.0, rotations="quarter", seed=11, time_limit=1)
     assert [p.placement for p in a.pieces] == [p.placement for p in b.pieces]
-    assert a.length == b.length and b.seconds < 0.5 <= a.seconds
+    assert a.length == b.length and b.cached and not a.cached
     fresh = patterns.layout(plates, width=300.0, rotations="quarter", seed=11, time_limit=1, cache=False)
-    assert fresh.seconds >= 0.5 and set(_marker_cache.iterdir()) - before == kept
+    assert not fresh.cached and set(_marker_cache.iterdir()) - before == kept
     patterns.layout(plates, width=300.0, rotations="quarter", seed=12, time_limit=1)
     assert len(set(_marker_cache.iterdir()) - before) == 2
 
@@ -199,6 +200,7 @@ def test_quantities_per_panel(plates):
     assert len(nest.pieces) == len(plates.panels) + 2
 
 
+@pytest.mark.slow
 def test_sheets_are_filled_one_after_another(plates):
     """Twelve rectangles on 400 x 300 mm sheets: every piece wholly on one sheet, sheets reported one by
     one with the area of their own pieces (shapely's) over the sheet's."""
@@ -317,6 +319,7 @@ def test_every_input_of_a_search_is_in_its_marker_key():
     assert all(re.fullmatch(r"[0-9a-f]{64}", k) for k in keys)  # a file name on any system
 
 
+@pytest.mark.slow
 def test_the_cache_folder_is_made_and_a_broken_marker_searched_anew(plates, tmp_path, monkeypatch):
     """The cache folder is made (parents too) at the first marker kept; a kept file that is not a marker
     (cut short, edited, another version's, NaN, a turn not allowed) or a marker that fails the check is never
@@ -340,6 +343,7 @@ def test_the_cache_folder_is_made_and_a_broken_marker_searched_anew(plates, tmp_
     assert first.length > 0
 
 
+@pytest.mark.slow
 def test_sheets_lie_a_sheet_spacing_apart(plates):
     """The sheets of a nest are drawn one after another along the roll's direction, SHEET_SPACING apart:
     sheet k from k x (length + spacing)."""

@@ -35,6 +35,7 @@ def _fill(matrix, order):
     return lu.L.nnz
 
 
+@pytest.mark.slow
 def test_a_dissection_order_is_a_permutation_that_keeps_the_factor_thin():
     v, f = surfaces.paraboloid_dish(n_faces=20_000)
     v, f, conn = validate_mesh(v, f)
@@ -123,6 +124,7 @@ sys.stdout.buffer.write(b"".join(np.ascontiguousarray(u).tobytes() for u in out)
 """
 
 
+@pytest.mark.slow
 def test_the_pattern_does_not_depend_on_the_blas_thread_count():
     """The same input gives the same pattern, bit for bit, with one BLAS thread or several:
     the engine sums without BLAS and holds BLAS to one thread (a head's relaxation is

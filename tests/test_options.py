@@ -162,15 +162,20 @@ def test_a_flag_makes_the_record_the_api_makes(argv, key, name, value):
 
 
 @pytest.mark.parametrize(("flag", "text", "message"), [
-    ("--max-darts", "-1", "max_darts must be an integer between 0 and 100, got -1"),
-    ("--k-factor", "1.5", "k_factor must be a number between 0 and 1, got 1.5"),
-    ("--text-height", "inf", "text_height must be a positive number <= 1e+07, got inf"),
-    ("--max-strain", "0", "max_strain must be a positive number, got 0"),
-    ("--max-iterations", "0", "max_iterations must be an integer between 1 and 100000, got 0"),
-    ("--chord-tolerance", "nan", "chord_tolerance must be a positive number <= 1e+07, got nan"),
+    ("--max-darts", "-1", "--max-darts must be an integer between 0 and 100, got -1"),
+    ("--k-factor", "1.5", "--k-factor must be a number between 0 and 1, got 1.5"),
+    ("--text-height", "inf", "--text-height must be a positive number <= 1e+07, got inf"),
+    ("--max-strain", "0", "--max-strain must be a ratio > 0 and <= 1 (0.03 means 3 %), got 0.0"),
+    ("--max-strain", "3", "--max-strain must be a ratio > 0 and <= 1 (0.03 means 3 %), got 3.0; 3 % is 0.03"),
+    ("--dart-strain", "5", "--dart-strain must be a ratio > 0 and <= 1 (0.03 means 3 %), got 5.0; 5 % is 0.05"),
+    ("--area-tolerance", "2", "--area-tolerance must be a ratio > 0 and <= 1 (0.03 means 3 %), got 2.0"),
+    ("--max-iterations", "0", "--max-iterations must be an integer between 1 and 100000, got 0"),
+    ("--chord-tolerance", "nan", "--chord-tolerance must be a positive number <= 1e+07, got nan"),
+    ("--nest-gap", "-1", "--nest-gap must be a number between 0 and 1e+07, got -1.0"),
 ])
 def test_a_bad_flag_fails_in_one_line_before_loading(tmp_path, capsys, flag, text, message):
-    """The CLI's refusal is the API's message, given before the (missing) input is even read."""
+    """The CLI's refusal is the API's message with the flag the user typed, given before the (missing) input is
+    even read."""
     code = cli.main(["flatten", str(tmp_path / "missing.step"), "-o", str(tmp_path / "x.dxf"), flag, text])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and message in err[0], err
@@ -178,7 +183,7 @@ def test_a_bad_flag_fails_in_one_line_before_loading(tmp_path, capsys, flag, tex
 
 
 def test_unknown_keywords_name_the_options():
-    with pytest.raises(InputError, match="unknown option 'max_strian'; the options are max_strain"):
+    with pytest.raises(InputError, match="unknown option 'max_strian'; did you mean max_strain\\?; the options are max_strain"):
         patterns.CheckOptions.of(None, {"max_strian": 0.1})
     pattern = patterns.flatten(patterns.load(SAMPLES / "hopper.step"))
     with pytest.raises(InputError, match="unknown option 'seam_alowance'"):
@@ -200,3 +205,75 @@ def test_the_unit_table(unit, mm, insunits):
     """AutoCAD's $INSUNITS codes (1 inch, 4 mm, 5 cm, 6 m) and the size of each unit."""
     assert patterns.Unit(unit).mm == mm and patterns.Unit(unit).insunits == insunits
     assert patterns.Unit(unit).measurement == (0 if unit == "in" else 1)
+
+
+def test_every_strain_option_is_a_ratio_and_says_how_to_write_a_percentage():
+    """Issue 34: max_strain=3 (meant as 3 %) was taken as 300 %; one rule for every strain option."""
+    for record, name in ((patterns.CheckOptions, "max_strain"), (patterns.FlattenOptions, "max_strain"),
+                         (patterns.CheckOptions, "area_tolerance")):
+        assert getattr(record.of(None, {name: 1}), name) == 1.0 and getattr(record.of(None, {name: 0.03}), name) == 0.03
+        for bad in (3, 1.0001, 0, -0.03, float("nan"), "3%"):
+            with pytest.raises(patterns.InputError, match=rf"^{name} must be a ratio > 0 and <= 1 \(0.03 means 3 %\)"):
+                record.of(None, {name: bad})
+
+
+def test_check_refuses_a_strain_limit_given_in_percent(tmp_path):
+    pattern = patterns.flatten(patterns.load(SAMPLES / "cone.obj"))
+    with pytest.raises(patterns.InputError, match=r"max_strain must be a ratio .* got 3; 3 % is 0.03"):
+        patterns.check(pattern, max_strain=3)
+    with pytest.raises(patterns.InputError, match=r"max_strain must be a ratio"):
+        patterns.heat_map(pattern, tmp_path / "h.png", max_strain=3)
+    assert not list(tmp_path.iterdir())
+
+
+def test_none_on_the_command_line_leaves_an_optional_option_unset():
+    """--area-tolerance None: the help offers it ("none: not checked"), and the record has None."""
+    for text in ("None", "none", "NONE"):
+        args = cli._parser().parse_args(["flatten", "part.step", "-o", "x.dxf", "--area-tolerance", text])
+        assert from_arguments(patterns.CheckOptions, args).area_tolerance is None
+    args = cli._parser().parse_args(["flatten", "part.step", "-o", "x.dxf"])
+    assert from_arguments(patterns.CheckOptions, args).area_tolerance == 0.05
+
+
+@pytest.mark.parametrize(("typed", "meant"), [("--seam-alowance", "--seam-allowance"), ("--max-strian", "--max-strain"),
+                                              ("--nest-tme", "--nest-time"), ("--roll-widht=100", "--roll-width")])
+def test_a_mistyped_flag_gets_a_did_you_mean_and_its_commands_help(tmp_path, capsys, typed, meant):
+    code = cli.main(["flatten", str(tmp_path / "missing.step"), "-o", str(tmp_path / "x.dxf"), typed, "5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    flag = typed.split("=")[0]
+    want = f"patterns: error: unknown option {flag}; did you mean {meant}? (patterns flatten --help lists the options)"
+    assert code == 2 and err == [want], err
+    assert not list(tmp_path.iterdir())
+
+
+def test_the_api_names_its_keyword_and_the_command_line_its_flag():
+    with pytest.raises(patterns.InputError, match=r"^gap 1e\+06 mm \(and margin 0 mm each side\) is as wide"):
+        patterns.NestOptions.of(None, {"width": 1500, "gap": 1e6})
+    with pytest.raises(patterns.InputError, match=r"^unknown option 'max_strian'; did you mean max_strain\?"):
+        patterns.CheckOptions.of(None, {"max_strian": 0.03})
+    args = cli._parser().parse_args(["flatten", "p.step", "-o", "x.dxf", "--roll-width", "1500", "--nest-gap", "1e6"])
+    with pytest.raises(patterns.InputError, match=r"^--nest-gap 1e\+06 mm \(and --margin 0 mm each side\)"):
+        from_arguments(patterns.NestOptions, args)
+    assert patterns.options.label("gap") == "gap"  # the flags are named only while the command line makes a record
+
+
+def test_a_flag_that_turns_an_option_off_says_what_it_does():
+    """--no-sew, --no-exact, --no-nest-cache, ...: their help is the option's off= text (what the flag does), never
+    the default's description; an option on by default without one is refused when the flags are made."""
+    import argparse
+
+    text = " ".join(cli._parser().commands["batch"].format_help().split())
+    for record in (patterns.LoadOptions, patterns.FlattenOptions, patterns.NestOptions, patterns.WriteOptions,
+                   patterns.BatchOptions):
+        for f in dataclasses.fields(record):
+            spec = f.metadata.get("spec")
+            if spec is not None and f.default is True:
+                flag = patterns.options.cli_flags(record)[f.name]
+                assert flag.startswith("--no-") and f"{flag} {' '.join(spec.off.split())}" in text, (flag, spec.off)
+
+    @dataclasses.dataclass(frozen=True)
+    class Careless(patterns.options.Options):
+        thing: bool = patterns.options.option(True, "a thing, on")
+
+    with pytest.raises(TypeError, match="needs off="):
+        patterns.options.add_arguments(argparse.ArgumentParser(), Careless)

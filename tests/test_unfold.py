@@ -366,6 +366,7 @@ def test_freecad_reads_the_blank_closed_at_its_area(strip_blank, tmp_path):
 # --------------------------------------------------------------------------- #
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("part", sorted(PARTS))
 def test_real_part_matches_solidworks(part):
     _need_parts()
@@ -382,6 +383,7 @@ def test_real_part_matches_solidworks(part):
         assert c.hausdorff <= 0.1  # the outline where no corner relief is drawn
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("part", sorted(PARTS))
 def test_where_the_outline_differs_from_solidworks_it_is_at_a_corner(part):
     """Every stretch of our outline more than 0.1 mm from SolidWorks' lies within 8 mm of the end of one of
@@ -401,6 +403,7 @@ def test_where_the_outline_differs_from_solidworks_it_is_at_a_corner(part):
         assert cKDTree(ends).query(far)[0].max() <= 8.0
 
 
+@pytest.mark.slow
 def test_each_part_unfolds_through_the_command_line(tmp_path, capsys):
     _need_parts()
     part = "MMP.03.00.00.001_Wheel_bracket_outer"
@@ -524,6 +527,7 @@ def test_exact_brackets_are_ok_everywhere(name, tmp_path, capsys):
     assert len(blank.holes) == 1 and blank.holes[0].is_circle and len(blank.bends) == len(profile) - 2
 
 
+@pytest.mark.slow
 def test_a_folder_of_real_parts_unfolds_in_a_batch(tmp_path):
     """``patterns batch IN -o OUT --unfold --k-factor 0.47`` on the shared OpenAMR parts: a row per part, each
     ``ok``; each DXF read back is the blank ``unfold`` makes (area, outer perimeter, holes, bend lines) and
@@ -574,6 +578,7 @@ def test_a_mesh_is_no_part_to_unfold_and_a_bend_table_is_never_overwritten(tmp_p
     assert "no CAD (STEP, BREP, IGES) files in this folder" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_a_batch_of_exact_brackets_flattens_ok(tmp_path):
     """The L, U and Z brackets flattened face by face in a batch: every row ``ok`` (the seams of exact
     developments judged on their exact lengths), every part's report ok."""

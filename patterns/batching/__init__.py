@@ -72,7 +72,9 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
         The output folder (made if missing; its folder must exist):
         ``NAME.dxf`` and ``NAME.json`` per part (``NAME_preview.png``,
         ``NAME_heatmap.png`` if asked), ``NAME`` the input's stem -- or its whole
-        name where two stems collide (``a.step.dxf``, ``a.stl.dxf``).
+        name where two stems collide (``a.step.dxf``, ``a.stl.dxf``), compared
+        ignoring case; whole names that still collide are numbered
+        (``part.step-2.dxf``): see :func:`output_stems`.
     records : dict, optional
         The part's option records (``"load"``, ``"flatten"``, ``"check"``,
         ``"dxf"``, ``"nest"``), as the command line makes them; default from
@@ -99,6 +101,12 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
     InputError
         Before any work: a bad option, no such folder or file, no part files,
         an output folder that cannot be made or written.
+
+    Notes
+    -----
+    Safe at a script's top level, with no ``if __name__ == "__main__":`` guard:
+    the local workers are fresh interpreters that run only this package
+    (:mod:`patterns.batching.local`) and never import the caller's ``__main__``.
     """
     opts, records = _options(options, records, keywords)
     if isinstance(files, (str, os.PathLike)) and Path(files).is_dir():

@@ -42,7 +42,8 @@ class BatchOptions(Options):
                                         "at least 1024 (what starting one takes); a file that needs more fails "
                                         "alone (default: the machine's memory shared among the processes)",
                                   low=1024, optional=True, high=1e9, metavar="MB")
-    report: bool = option(True, "write each part's JSON report (NAME.json); --no-report leaves it out")
+    report: bool = option(True, "write each part's JSON report (NAME.json); --no-report leaves it out",
+                          off="write no JSON report (NAME.json) per part")
     preview: bool = option(False, "also render each DXF at 1:1 (NAME_preview.png)")
     heat_map: bool = option(False, "also draw each part's strain heat map (NAME_heatmap.png)")
     unfold: bool = option(False, "unfold every part as bent sheet metal into one blank each (NAME.dxf and NAME.json; "
@@ -115,22 +116,46 @@ class BatchResult:
 def output_stems(files) -> dict:
     """``{input path: output stem}``: the name without its suffix, unless two inputs would share it.
 
-    ``a.step`` and ``a.stl`` both give ``a``: then each keeps its whole name
-    (``a.step.dxf``, ``a.stl.dxf``), so that neither overwrites the other.  A
-    stem that is not a plain name (``.``, ``..``, empty) keeps the whole name too.
+    Names are compared case-folded, as a case-insensitive disk (macOS, Windows, a USB stick, a network share)
+    compares them.  ``a.step`` and ``a.stl`` both give ``a``: then each keeps its whole name
+    (``a.step.dxf``, ``a.stl.dxf``), so that neither overwrites the other; so do ``Part.step`` and
+    ``part.stl``.  A stem that is not a plain name (``.``, ``..``, empty) keeps the whole name too.  Names that
+    still collide -- ``Part.step`` and ``part.step``, or one name in two folders -- are numbered after the
+    first, in the order of ``files`` (``part.step-2``).
     """
     stems = {}
     for path in files:
         stem = Path(path).stem
         stems[path] = stem if stem not in ("", ".", "..") else Path(path).name
-    folded = {}
-    for path, stem in stems.items():
-        folded.setdefault(stem.casefold(), []).append(path)  # a.STEP and a.step collide on some disks too
-    for group in folded.values():
-        if len(group) > 1:
+    changed = True
+    while changed:  # a whole name may meet another's stem (a.step, a.stl and a.step.obj): until none meet
+        changed = False
+        for group in _collisions(stems):
             for path in group:
+                changed |= stems[path] != Path(path).name
                 stems[path] = Path(path).name
+    taken = {_fold(stem) for stem in stems.values()}
+    for group in _collisions(stems):
+        for path in group[1:]:
+            number = 2
+            while _fold(f"{stems[path]}-{number}") in taken:
+                number += 1
+            stems[path] = f"{stems[path]}-{number}"
+            taken.add(_fold(stems[path]))
     return stems
+
+
+def _fold(name: str) -> str:
+    """A name as a case-insensitive disk compares it."""
+    return name.casefold()
+
+
+def _collisions(stems: dict) -> list:
+    """The groups of inputs (in their order) whose stems are one name on a case-insensitive disk."""
+    groups = {}
+    for path, stem in stems.items():
+        groups.setdefault(_fold(stem), []).append(path)
+    return [group for group in groups.values() if len(group) > 1]
 
 
 _SUFFIXES = {"pattern": "{}.dxf", "report": "{}.json", "preview": "{}_preview.png", "heat_map": "{}_heatmap.png"}
@@ -154,6 +179,9 @@ def plan_batch(folder, out, *, unfold: bool = False) -> tuple[list, dict]:
     With ``unfold``, CAD files only (a mesh is no bent solid)."""
     folder, out = Path(folder), Path(out)
     if not folder.is_dir():
+        if folder.exists():
+            raise InputError(f"{os.fsdecode(folder)}: is a file, not a folder; batch takes a folder of parts "
+                             f"(every CAD and mesh file directly in it)")
         raise InputError(f"{os.fsdecode(folder)}: no such folder")
     kinds = CAD_SUFFIXES if unfold else CAD_SUFFIXES + MESH_SUFFIXES
     files = sorted(p for p in folder.iterdir() if p.suffix.lower() in kinds and p.is_file())

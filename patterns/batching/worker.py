@@ -3,14 +3,21 @@
 :func:`process_part` runs the whole pipeline (:func:`patterns.jobs.flatten_part`,
 or :func:`patterns.jobs.unfold_part` for a bent sheet-metal part) on a part
 given as bytes, in a private temporary folder, and never raises for the
-part's fault.  :func:`worker_main` is a local worker process's loop.
+part's fault.  :func:`worker_main` is a local worker process's loop, and
+:func:`spawn_main` its entry point: a worker is a fresh interpreter that runs
+only this module (never the user's ``__main__``), talking to its parent over a
+:class:`Channel`.
 """
 
 from __future__ import annotations
 
 import contextlib
+import json
 import os
+import pickle
 import signal
+import socket
+import struct
 import sys
 import tempfile
 import time
@@ -21,7 +28,7 @@ from ..findings import Code
 from ..jobs import PartResult, flatten_part, unfold_part
 from .plan import _SUFFIXES
 
-__all__ = ["OUT_OF_MEMORY", "process_part", "worker_main"]
+__all__ = ["OUT_OF_MEMORY", "Channel", "process_part", "spawn_main", "worker_main"]
 
 
 def process_part(name: str, data: bytes, records: dict, wanted: tuple) -> dict:
@@ -84,12 +91,64 @@ def _numbers(part: PartResult) -> dict:
             "strain_rms": max(p.strain_rms for p in report.panels), "strain_max": max(p.strain_max for p in report.panels)}
 
 
-def worker_main(conn, budget: int | None, one_thread: bool) -> None:  # pragma: no cover - in a child process
+class Channel:
+    """One end of a local worker's line to its parent: whole pickled messages over a stream socket (a length,
+    then the pickle).  ``recv`` raises EOFError once the other end is gone; ``fileno`` lets
+    :func:`multiprocessing.connection.wait` watch it."""
+
+    _HEAD = struct.Struct("!Q")
+
+    def __init__(self, sock: socket.socket):
+        self.sock = sock
+
+    def fileno(self) -> int:
+        return self.sock.fileno()
+
+    def send(self, message) -> None:
+        data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+        self.sock.sendall(self._HEAD.pack(len(data)))
+        self.sock.sendall(data)
+
+    def recv(self):
+        (size,) = self._HEAD.unpack(self._read(self._HEAD.size))
+        return pickle.loads(self._read(size))
+
+    def _read(self, size: int) -> bytearray:
+        data = bytearray(size)
+        view, got = memoryview(data), 0
+        while got < size:
+            n = self.sock.recv_into(view[got:])
+            if not n:
+                raise EOFError("the other end of the channel is closed")
+            got += n
+        return data
+
+    def close(self) -> None:
+        self.sock.close()
+
+
+def spawn_main() -> None:  # pragma: no cover - in a child process
+    """A local worker process's entry point (``python -c``, see :mod:`patterns.batching.local`): its settings in
+    ``sys.argv[1]`` as JSON -- the parent's ``sys.path`` (already in place when this module is imported), the
+    channel's file descriptor (None on Windows: the shared socket on stdin), the memory budget, one BLAS thread
+    or not, the parent's process id."""
+    settings = json.loads(sys.argv[1])
+    if settings["fd"] is None:  # Windows: the socket, shared with this process, comes on stdin
+        channel = Channel(socket.fromshare(sys.stdin.buffer.read()))
+    else:
+        channel = Channel(socket.socket(fileno=settings["fd"]))
+    worker_main(channel, settings["budget"], settings["one_thread"], parent=settings["parent"])
+
+
+def worker_main(conn, budget: int | None, one_thread: bool, *, parent: int | None = None) -> None:  # pragma: no cover
     """A local worker: dies with its parent, ignores Ctrl-C (the parent stops it), stays in its memory budget,
-    and never prints: what goes wrong goes back to the parent, or the worker just ends."""
+    and never prints: what goes wrong goes back to the parent, or the worker just ends.  A worker that cannot
+    start says why, and whether memory (its budget) was the cause."""
     try:
-        _die_with_parent()
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+        _die_with_parent()
+        if parent is not None and os.getppid() != parent:  # the parent died before the line above
+            os._exit(1)
         if budget:
             import resource
 
@@ -106,7 +165,8 @@ def worker_main(conn, budget: int | None, one_thread: bool) -> None:  # pragma: 
 
             from .. import jobs  # noqa: F401
         except BaseException as exc:  # noqa: BLE001 - said to the parent, which stops the batch
-            conn.send(("cannot start", f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"))
+            said = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+            conn.send(("cannot start", said, bool(budget) and out_of_memory(said)))
             return
         conn.send("ready")  # a file's time starts when it is handed over, not while the worker starts
         while True:
@@ -122,6 +182,16 @@ def worker_main(conn, budget: int | None, one_thread: bool) -> None:  # pragma: 
 
 OUT_OF_MEMORY = 3
 """A local worker's exit code when a file's bytes alone exceed its memory budget."""
+
+_MEMORY_WORDS = ("memoryerror", "cannot allocate memory", "out of memory", "failed to map segment", "bad_alloc",
+                 "memory regions")
+
+
+def out_of_memory(said: str) -> bool:
+    """Whether what a failing worker said (an exception, its last words on stderr) names memory as the cause:
+    Python's MemoryError, ENOMEM, a shared library that cannot be mapped, C++'s bad_alloc, OpenBLAS's buffers."""
+    said = said.casefold()
+    return any(word in said for word in _MEMORY_WORDS)
 
 
 def _die_with_parent() -> None:

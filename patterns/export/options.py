@@ -44,7 +44,9 @@ class WriteOptions(Options):
                                    "(role= leaves a role out); see docs/dxf.md", check=layer_map, parse=str,
                                  metavar="MAP")
     bend_lines: bool = option(True, "draw bend and ruling lines (--no-bend-lines leaves them and their labels out, "
-                                    "for a cutter that would cut them)", flag="--no-bend-lines")
+                                    "for a cutter that would cut them)", flag="--no-bend-lines",
+                                    off="leave bend and ruling lines and their labels out (for a cutter that would "
+                                        "cut them)")
 
     def __post_init__(self):
         super().__post_init__()

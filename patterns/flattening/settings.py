@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..options import Options, option
+from ..options import Options, label, option
 from .energy import ENERGIES
 from .seams import Ease, SeamLengths
 
@@ -86,7 +86,9 @@ class FlattenOptions(Options):
                                     "the least strain, always one-to-one: for patterns), isometric (the greedy "
                                     "grower alone) or conformal (the paper as written)", choices=METHODS)
     exact: bool = option(True, "unroll planar, cylindrical and conical CAD faces analytically (exact, strain 0); "
-                               "the command line's --no-exact sends them through the mesh engine too")
+                               "the command line's --no-exact sends them through the mesh engine too",
+                               off="send planar, cylindrical and conical CAD faces through the mesh engine too, "
+                                   "instead of unrolling them analytically")
     thickness: float = option(0.0, "sheet thickness, mm: develop the neutral surface, k_factor x thickness from "
                                    "the inside skin", low=0, unit="mm")
     k_factor: float = option(0.5, "position of the neutral surface from the inside skin, 0..1", low=0, high=1,
@@ -103,7 +105,7 @@ class FlattenOptions(Options):
     max_strain: float | None = option(None, "cut darts into a freeform panel whose worst triangle strain is "
                                             "above this ratio (0.03 = 3 %): the fewest evenly spaced darts, as short "
                                             "as the limit allows",
-                                      low=0, low_open=True, optional=True, flag="--dart-strain", metavar="R")
+                                      optional=True, unit="ratio", flag="--dart-strain")
     max_darts: int = option(12, "at most this many darts per panel (with gores: cuts), 0..100", low=0, high=100,
                             integer=True, metavar="N")
     gores: bool = option(False, "with a strain limit: split a panel above it into gores along the dart lines, "
@@ -124,8 +126,8 @@ class FlattenOptions(Options):
         if self.method != "relaxed":
             for name in ("ease", "min_stretch"):
                 if getattr(self, name) is not None:
-                    raise InputError(f"{name} applies to method='relaxed' only")
+                    raise InputError(f"{label(name)} applies to {label('method')} relaxed only")
             if self.energy != "auto":
-                raise InputError("energy applies to method='relaxed' only")
+                raise InputError(f"{label('energy')} applies to {label('method')} relaxed only")
         if self.ease and self.seams == "free":
-            raise InputError("ease needs seams='true' or 'total'")
+            raise InputError(f"{label('ease')} needs {label('seams')} true or total")

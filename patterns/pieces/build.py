@@ -4,7 +4,10 @@ A pattern gives one piece per panel (:func:`~patterns.pieces.panel.panel_piece`)
 a blank gives one piece: its exact outline and holes, its bend lines with
 their direction, angle, inside radius and K-factor, and its findings.  A list
 of patterns, blanks and pieces gives all their pieces, named
-``"<part>/<piece>"`` when more than one part is in it.
+``"<part>/<piece>"`` when more than one part is in it.  Each piece made here
+also carries a ``label-left-out`` note for every label that does not fit on it
+at the least text height (:func:`~patterns.pieces.labels.label_findings`): the
+writers leave that label out.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from ..findings import Finding
 from ..pattern import Pattern
 from ..text import printable
 from .allowance import allowance_lookup
+from .labels import label_findings
 from .options import PieceOptions, check_marks
 from .panel import panel_piece, text_height_for
 from .piece import BendLine, Piece, Source
@@ -87,14 +91,18 @@ def pieces_of(source, options: PieceOptions | None = None, *, findings: Iterable
     groups = []
     for item in items:
         if isinstance(item, Pattern):
-            groups.append((item.name, _pattern_pieces(item, opts, findings), True))
+            groups.append((item.name, _pattern_pieces(item, opts, findings), True, True))
         elif isinstance(item, Blank):
-            groups.append((item.name, [blank_piece(item, opts)], False))
+            groups.append((item.name, [blank_piece(item, opts)], False, True))
         elif isinstance(item, Piece):
-            groups.append((item.source.part, [item], False))
+            groups.append((item.source.part, [item], False, False))  # taken as it is, its notes with it
         else:
             raise InputError(f"expected a patterns.Pattern, Blank or Piece (or a list of them), got "
                              f"{type(item).__name__}")
-    several = len({part for part, _, _ in groups}) > 1  # a panel's name then says its part: "cup/face0"
-    return tuple(replace(p, name=f"{printable(part)}/{p.name}") if several and prefix else p
-                 for part, ps, prefix in groups for p in ps)
+    several = len({group[0] for group in groups}) > 1  # a panel's name then says its part: "cup/face0"
+    out = []
+    for part, ps, prefix, made in groups:
+        for p in ps:
+            p = replace(p, name=f"{printable(part)}/{p.name}") if several and prefix else p
+            out.append(replace(p, findings=tuple(p.findings) + label_findings(p)) if made else p)
+    return tuple(out)

@@ -3,28 +3,50 @@
 Every text the DXF writers put on a panel (its name, its strain, a seam's
 lengths, a bend's angle) asks for a place: it is tried at the places it
 prefers (first the one it asks for), then at smaller sizes, and taken at the
-first where its box lies inside the finished piece (the seam line's polygon),
-a quarter of its height clear of the outline, and off every label already
-placed.  A label that fits nowhere at a third of its size is left out rather
-than drawn across a cut.  Boxes are measured with ezdxf's font metrics of the
-standard style, 10 % wider for readers with wider fonts.
+first where its box lies inside the finished piece (the seam line's polygon,
+clear of its holes), a quarter of its height clear of the outline, and off
+every label already placed.  No label is drawn below
+:data:`LEAST_TEXT_HEIGHT` (2 mm; or the piece's text height, when a smaller
+one was asked for): one that fits nowhere at that height is left out rather
+than shrunk or drawn across a cut, and :func:`label_findings` says so (a
+``label-left-out`` note on the piece).  Boxes are measured with ezdxf's font
+metrics of the standard style, 10 % wider for readers with wider fonts.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 import shapely
 
+from ..findings import Code, Finding, Severity
 from ..units import Unit
 from .piece import Piece, SeamSide
 
-__all__ = ["Label", "LabelPlacer", "piece_labels", "readable_angle", "seam_text", "text_box"]
+__all__ = ["LEAST_TEXT_HEIGHT", "Label", "LabelPlacer", "label_findings", "least_height", "piece_labels",
+           "readable_angle", "seam_text", "text_box"]
 
 SCALES = (1.0, 0.8, 0.64, 0.5, 0.4, 0.33)
-"""The sizes a label is tried at, as fractions of the size it asks for."""
+"""The sizes a label is tried at, as fractions of the size it asks for (never below the least height)."""
+
+LEAST_TEXT_HEIGHT = 2.0
+"""The least height of any label, mm: the low end of the default text height (3 % of a piece's size, 2-12 mm).
+A label that does not fit at it is left out, with a finding; never drawn smaller."""
+
+
+def least_height(text_height: float) -> float:
+    """The least label height on a piece whose text height is ``text_height`` mm: :data:`LEAST_TEXT_HEIGHT`,
+    or ``text_height`` itself when it is smaller (only ever when asked for explicitly)."""
+    return min(LEAST_TEXT_HEIGHT, float(text_height))
+
+
+def _heights(height: float, floor: float) -> list:
+    """The heights a label that asks for ``height`` is tried at: :data:`SCALES` of it while above ``floor``,
+    then ``floor`` itself (only ``floor`` when it asks for less)."""
+    out = [height * s for s in SCALES if height * s > floor * (1 + 1e-9)]
+    return out if len(out) == len(SCALES) else out + [floor]
 
 
 @lru_cache(maxsize=1)
@@ -70,43 +92,66 @@ class LabelPlacer:
     Parameters
     ----------
     piece : shapely.Polygon
-        The finished piece (the seam line's polygon), mm.
+        The finished piece (the seam line's polygon, its holes with it), mm.
+    least : float
+        No label is placed smaller than this, mm (default :data:`LEAST_TEXT_HEIGHT`).
     """
 
-    def __init__(self, piece: shapely.Polygon):
+    def __init__(self, piece: shapely.Polygon, least: float = LEAST_TEXT_HEIGHT):
         self.piece = piece
+        self.least = float(least)
         self.boxes = []
         self.labels = []
         self.left_out = []
+        """The labels that fit nowhere: each as it asked to be drawn, at its first place and the least height."""
+        self._inner = {}
 
-    def place(self, text: str, places, height: float, angle: float = 0.0) -> Label | None:
+    def _inside(self, margin: float):
+        if margin not in self._inner:
+            inner = self.piece.buffer(-margin)
+            shapely.prepare(inner)
+            self._inner[margin] = inner
+        return self._inner[margin]
+
+    def place(self, text: str, places, height: float, angle=0.0, *, kind: str = "title", of: int = -1,
+              shift: float = 0.0, note: bool = True) -> Label | None:
         """Put ``text`` at the first of ``places`` ((k, 2) mm, in order of preference) where it fits,
-        at ``height`` or smaller; None (and noted in :attr:`left_out`) when it fits nowhere."""
-        block = self.place_block([(text, 0.0, 1.0)], places, height, angle)
+        at ``height`` or smaller down to the least height; None (and noted in :attr:`left_out`) when it fits
+        nowhere (``note``).  ``angle`` (degrees) may be a sequence of angles, tried in turn, each at every size."""
+        block = self.place_block([(text, 0.0, 1.0)], places, height, angle, kind=kind, of=of, shift=shift, note=note)
         return block[0] if block else None
 
-    def place_block(self, lines, places, height: float, angle: float = 0.0) -> list:
+    def place_block(self, lines, places, height: float, angle=0.0, *, kind: str = "title", of: int = -1,
+                    shift: float = 0.0, note: bool = True) -> list:
         """Place lines of text together: ``lines`` are ``(text, offset, size)``, the offset of each line's
         middle across the block and its cap height, both in units of ``height``; the block is tried at
-        ``places`` ((k, 2) mm) and shrunk as a whole.  Returns the placed :class:`Label` list, empty
-        when the block fits nowhere (its texts then noted in :attr:`left_out`)."""
+        ``places`` ((k, 2) mm), shrunk as a whole down to where its smallest line is at the least height,
+        at each of ``angle`` in turn (degrees: one or a sequence).  ``shift`` moves each line along itself
+        by that many half widths (1: the line starts at its place).  Returns the placed :class:`Label`
+        list, empty when the block fits nowhere (its lines then noted in :attr:`left_out`, if ``note``)."""
         places = np.asarray(places, dtype=np.float64).reshape(-1, 2)
-        a = np.radians(angle)
-        across = np.array([-np.sin(a), np.cos(a)])
-        for scale in SCALES:
-            h = height * scale
-            inner = self.piece.buffer(-0.25 * h)
-            if inner.is_empty:
-                continue
-            for at in places:
-                boxes = [text_box(t, at + off * h * across, size * h, angle) for t, off, size in lines]
-                if all(inner.contains(b) for b in boxes) and not any(
-                        b.intersects(c) for b in boxes for c in self.boxes):
-                    self.boxes.extend(boxes)
-                    placed = [Label(t, at + off * h * across, size * h, angle) for t, off, size in lines]
-                    self.labels.extend(placed)
-                    return placed
-        self.left_out.extend(t for t, _, _ in lines)
+        angles = [float(a) for a in np.atleast_1d(angle)]
+        floor = self.least / min(size for _, _, size in lines)
+        for a in angles:  # level (the first angle) at every size down to the least, then turned
+            r = np.radians(a)
+            along_dir, across = np.array([np.cos(r), np.sin(r)]), np.array([-np.sin(r), np.cos(r)])
+            for h in _heights(height, floor):
+                inner = self._inside(0.25 * h)
+                for at in places:
+                    centres = [at + off * h * across + shift * 0.55 * text_width(t, size * h) * along_dir
+                               for t, off, size in lines]  # shift: half the box's (10 % widened) width
+                    boxes = [text_box(t, c, size * h, a) for (t, _, size), c in zip(lines, centres)]
+                    if all(inner.contains(b) for b in boxes) and not any(
+                            b.intersects(c) for b in boxes for c in self.boxes):
+                        self.boxes.extend(boxes)
+                        placed = [Label(t, c, size * h, a, kind, of) for (t, _, size), c in zip(lines, centres)]
+                        self.labels.extend(placed)
+                        return placed
+        if not note:
+            return []
+        first = places[0] if len(places) else np.zeros(2)
+        self.left_out.extend(Label(t, first, max(size * floor, self.least), angles[0], kind, of)
+                             for t, _, size in lines)
         return []
 
     def inside_places(self, near, step: float, limit: int = 300) -> np.ndarray:
@@ -162,8 +207,81 @@ def seam_text(side: SeamSide, unit: Unit = Unit.MM) -> str:
             f"{unit.label}")
 
 
+def _long_axis(polygon: shapely.Polygon) -> float:
+    """The readable angle (degrees) of the longer side of the polygon's smallest turned rectangle."""
+    ring = np.asarray(shapely.minimum_rotated_rectangle(polygon).exterior.coords)
+    if len(ring) < 4:
+        return 0.0
+    sides = np.diff(ring[:3], axis=0)
+    return readable_angle(max(sides, key=lambda d: float(np.hypot(*d))))
+
+
+def _placer(piece: Piece, unit: Unit, block) -> LabelPlacer:
+    """Every label of a piece placed (:func:`piece_labels`), with those that fit nowhere: the title block
+    first, or last when that leaves fewer labels out (a title as wide as a narrow piece bars the labels of
+    its long seams)."""
+    first = _place_all(piece, unit, block, title_first=True)
+    if not first.left_out:
+        return first
+    last = _place_all(piece, unit, block, title_first=False)
+    return last if len(last.left_out) < len(first.left_out) else first
+
+
+def _title(placer: LabelPlacer, piece: Piece, block, angles) -> None:
+    """The title block; where it fits nowhere, its first line (the piece's name) alone, the rest left out."""
+    places = placer.inside_places(piece.label_at, piece.text_height)
+    if placer.place_block(block, places, piece.text_height, angles, note=len(block) == 1) or len(block) == 1:
+        return
+    text, _, size = block[0]
+    placer.place_block([(text, 0.0, size)], places, piece.text_height, angles)
+    placer.left_out.extend(Label(t, places[0], max(size_ * piece.text_height, placer.least), 0.0)
+                           for t, _, size_ in block[1:])
+
+
+def _place_all(piece: Piece, unit: Unit, block, *, title_first: bool) -> LabelPlacer:
+    placer = LabelPlacer(piece.finished, least_height(piece.text_height))
+    th = piece.text_height
+    if block is None:
+        block = [(piece.name, 0.8, 1.2)] + [(line, -0.9, 0.7) for line in piece.title[:1]]
+    turned = _long_axis(piece.finished)
+    angles = (0.0,) if abs(turned) < 1e-6 else (0.0, turned)  # a narrow piece: along its length when need be
+    if title_first:
+        _title(placer, piece, block, angles)
+    for k, side in enumerate(piece.seams):
+        text = seam_text(side, unit)
+        h = max(0.6 * th, placer.least)
+        tries = along(side.points, 1.6 * h)
+        if not any(placer.place(text, [place], h, readable_angle(tangent), kind="seam", of=k, note=False)
+                   for place, tangent in tries):
+            placer.left_out.append(Label(text, tries[0][0], h, readable_angle(tries[0][1]), "seam", k))
+    for k, bend in enumerate(piece.bends):
+        a, b = bend.line
+        length = float(np.linalg.norm(b - a))
+        direction = (b - a) / max(length, 1e-12)
+        h = max(0.5 * th, placer.least)
+        places = [b - direction * f * length for f in (0.1, 0.3, 0.5, 0.7, 0.9)]
+        if placer.place(bend.label, places, h, readable_angle(direction), kind="bend", of=k, note=False):
+            continue
+        # too long for its line (a narrow blank): across it, beside its middle, on either side
+        normal = np.array([-direction[1], direction[0]])
+        for side in (normal, -normal):
+            angle = readable_angle(side)
+            shift = 1.0 if np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))]) @ side > 0 else -1.0
+            if placer.place(bend.label, [p + side * 0.5 * h for p in places[2:0:-1] + places[3:4]], h, angle, kind="bend", of=k,
+                            shift=shift, note=False):
+                break
+        else:
+            placer.left_out.append(Label(bend.label, 0.5 * (a + b), h, readable_angle(direction), "bend", k))
+    if not title_first:
+        _title(placer, piece, block, angles)
+        placer.labels.sort(key=lambda label: label.kind != "title")  # the title block first, as always
+    return placer
+
+
 def piece_labels(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> list:
-    """Every label of a piece, each placed clear of the others inside the finished piece.
+    """Every label of a piece, each placed clear of the others inside the finished piece, none below the
+    least height (:func:`least_height`): one that does not fit there is left out
+    (:func:`label_findings` says which).
 
     Parameters
     ----------
@@ -177,28 +295,22 @@ def piece_labels(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> list:
     Returns
     -------
     list of Label
-        The title block (kind ``"title"``), then one label per seam side (``"seam"``, 0.6 text heights,
-        along the seam and 1.6 label heights inside it, its middle first), then one per bend line
-        (``"bend"``, half a text height, centred on the line).
+        The title block (kind ``"title"``: level, or along a narrow piece's length where it fits only
+        so), then one label per seam side (``"seam"``, 0.6 text heights, along the seam and 1.6 label
+        heights inside it, its middle first), then one per bend line (``"bend"``, half a text height,
+        centred on the line, or across it beside its middle when the line is too short).
     """
-    placer = LabelPlacer(piece.finished)
-    th = piece.text_height
-    if block is None:
-        block = [(piece.name, 0.8, 1.2)] + [(line, -0.9, 0.7) for line in piece.title[:1]]
-    out = list(placer.place_block(block, placer.inside_places(piece.label_at, th), th))
-    for k, side in enumerate(piece.seams):
-        text = seam_text(side, unit)
-        for place, tangent in along(side.points, 1.6 * 0.6 * th):
-            label = placer.place(text, [place], 0.6 * th, readable_angle(tangent))
-            if label is not None:
-                out.append(replace(label, kind="seam", of=k))
-                break
-    for k, bend in enumerate(piece.bends):
-        a, b = bend.line
-        length = float(np.linalg.norm(b - a))
-        direction = (b - a) / max(length, 1e-12)
-        places = [b - direction * f * length for f in (0.1, 0.3, 0.5, 0.7, 0.9)]
-        label = placer.place(bend.label, places, 0.5 * th, readable_angle(direction))
-        if label is not None:
-            out.append(replace(label, kind="bend", of=k))
-    return out
+    return _placer(piece, unit, block).labels
+
+
+def label_findings(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> tuple:
+    """One ``label-left-out`` note per label of ``piece`` that fits nowhere on it at the least height
+    (:func:`piece_labels` leaves it out): which label, on which piece, and where it was wanted."""
+    placer = _placer(piece, unit, block)
+    what = f"panel {piece.name}" if piece.source.kind == "panel" else piece.name
+    out = []
+    for label in placer.left_out:
+        out.append(Finding(Code.LABEL_LEFT_OUT, Severity.NOTE, (piece.name,), label.at[None, :], (), None,
+                           f"{what}: {label.kind} label {label.text!r} does not fit on the piece at the least text "
+                           f"height ({placer.least:g} mm): left out"))
+    return tuple(out)

@@ -70,7 +70,9 @@ class PieceOptions(Options):
                                "blank's are exact lines and arcs already)")
     arc_tolerance: float = option(0.01, "largest distance of the fitted arcs from the contour, mm",
                                   low=0, low_open=True, unit="mm")
-    text_height: float | None = option(None, "label height, mm (default 3 % of each piece's size, 2-12 mm)",
+    text_height: float | None = option(None, "label height, mm (default 3 % of each piece's size, 2-12 mm); no label "
+                                             "is drawn below 2 mm (or below a smaller height given here): one that "
+                                             "does not fit is left out, with a label-left-out note",
                                        low=0, low_open=True, optional=True, unit="mm")
     gap: float | None = option(None, "space between pieces when they are not nested, mm (default 8 % of the largest)",
                                low=0, optional=True, unit="mm")

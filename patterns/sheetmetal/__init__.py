@@ -30,6 +30,7 @@ from ..errors import InputError
 from ..findings import Code, Finding, Severity
 from ..reading import CAD_SUFFIXES, check_source, read_cad
 from ..tessellate.topology import read_topology
+from ..text import counted
 from .bends import curvatures, face_maps, group_bends
 from .contour import bend_line, cut_loops, overlaps
 from .faces import recognise, uv_mid
@@ -109,7 +110,7 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
         findings.append(Finding(
             Code.MESHED_FACE, Severity.NOTE, (name,), flat(maps, motions, i, [uv_mid(faces[i].face)]), (), None,
             f"{name}: face {i} is not developable as a plane, cylinder or cone: meshed "
-            f"({len(m.triangles)} triangles) and flattened, strain up to {d.strain_max:.3%} (rms "
+            f"({counted(len(m.triangles), 'triangle')}) and flattened, strain up to {d.strain_max:.3%} (rms "
             f"{d.strain_rms:.3%}); its edges land within {gaps[i]:.3f} mm of the faces beside it"))
     order = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
     findings.sort(key=lambda f: order[f.severity])

@@ -138,7 +138,8 @@ class MeshingOptions(Options):
                                   "each, e.g. {'front': [0, 1]}; on the command line NAME=0,1 (repeatable)",
                             check=_panel_groups, parse=parse_panel, repeat=True, flag="--panel", metavar="NAME=FACES")
     sew: bool = option(True, "CAD: sew faces that meet along an edge without sharing it (a file of loose "
-                             "faces), so that the edge becomes a seam; --no-sew leaves them apart")
+                             "faces), so that the edge becomes a seam; --no-sew leaves them apart",
+                             off="CAD: leave faces that meet along an edge without sharing it apart (no seam there)")
 
 
 def mesh_shape(shape, options: MeshingOptions | None = None, *, name: str = "shape", **keywords) -> Model:
