@@ -21,13 +21,15 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import shutil
 import stat
+import sys
 import tempfile
 from pathlib import Path
 
 from .errors import ExportError, InputError
 
-__all__ = ["Outputs", "atomic_output", "check_input_file", "output_target", "same_file"]
+__all__ = ["Outputs", "atomic_output", "check_input_file", "child_python", "output_target", "same_file"]
 
 TEMP_PREFIX = ".~patterns-"
 """Temporary files start with this (and are removed when a write fails)."""
@@ -284,3 +286,12 @@ def check_input_file(path, *, what: str = "file") -> Path:
     if not os.access(path, os.R_OK):
         raise InputError(f"{shown}: cannot read the {what} (permission denied)")
     return path
+
+
+def child_python() -> str | None:
+    """A Python to run a child process of ours with (sparrow's, a batch's workers): this one, or inside FreeCAD
+    (whose ``sys.executable`` is FreeCAD's) the system's Python of the same version on PATH; None if there is
+    none (the caller says what could not start)."""
+    if Path(sys.executable).name.startswith("python"):
+        return sys.executable
+    return shutil.which(f"python{sys.version_info.major}.{sys.version_info.minor}") or shutil.which("python3")

@@ -31,7 +31,6 @@ import hashlib
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
 import time
@@ -45,7 +44,7 @@ from shapely import affinity
 
 from .curves import Motion
 from .errors import InputError, LayoutError, PatternsError
-from .files import atomic_output
+from .files import atomic_output, child_python
 from .options import Options, check_number, label, option
 from .pieces import Drawing, Piece, PieceOptions, pieces_of
 from .pieces.drawing import place_nest
@@ -445,11 +444,8 @@ CHILD = Path(__file__).with_name("sparrow_child.py")
 
 
 def _python() -> str:
-    """A Python to run :data:`CHILD` with: this one, or inside FreeCAD (whose executable is FreeCAD's) the
-    system's Python of the same version."""
-    if Path(sys.executable).name.startswith("python"):
-        return sys.executable
-    found = shutil.which(f"python{sys.version_info.major}.{sys.version_info.minor}") or shutil.which("python3")
+    """A Python to run :data:`CHILD` with (:func:`patterns.files.child_python`)."""
+    found = child_python()
     if found is None:
         raise LayoutError(f"no python{sys.version_info.major}.{sys.version_info.minor} on PATH to run sparrow in")
     return found

@@ -21,7 +21,6 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import shutil
 import signal
 import socket
 import subprocess
@@ -34,6 +33,7 @@ from pathlib import Path
 from typing import IO
 
 from ..errors import PatternsError
+from ..files import child_python
 from ..text import printable
 from .plan import BatchOptions, largest_first
 from .worker import OUT_OF_MEMORY, Channel, out_of_memory
@@ -218,13 +218,10 @@ class LocalRunner:
 
 
 def _python() -> str:
-    """The Python to run a worker with: this one, or inside FreeCAD (whose executable is FreeCAD's) the system's
-    Python of the same version (as :func:`patterns.nesting._python` finds sparrow's)."""
-    if Path(sys.executable).name.startswith("python"):
-        return sys.executable
-    version = f"python{sys.version_info.major}.{sys.version_info.minor}"
-    found = shutil.which(version) or shutil.which("python3")
+    """The Python to run a worker with (:func:`patterns.files.child_python`)."""
+    found = child_python()
     if found is None:
+        version = f"python{sys.version_info.major}.{sys.version_info.minor}"
         raise PatternsError(f"the worker processes cannot start (no {version} on PATH to run them; "
                             f"this process runs in {sys.executable})")
     return found
