@@ -1,11 +1,18 @@
-"""FreeCAD SheetMetal's unfolder on the shared sheet-metal parts, as a peer for ``patterns.unfold``.
+"""FreeCAD SheetMetal's unfolder on the shared sheet-metal parts (or any folder of parts), as a peer for ``patterns.unfold``.
 
 Run from the repository root (FreeCAD's ``freecadcmd`` on the PATH, the SheetMetal
 workbench checked out, ``../shared/sheetmetal`` beside the repository)::
 
+    apt-get install -y freecad python3-networkx   # the workbench imports networkx
     git clone https://github.com/shaise/FreeCAD_SheetMetal /tmp/FreeCAD_SheetMetal
+    git -C /tmp/FreeCAD_SheetMetal checkout cbef3f2
     python benchmarks/freecad_sheetmetal.py --workbench /tmp/FreeCAD_SheetMetal --out /tmp/freecad_flat
     python benchmarks/sheet_metal.py --freecad /tmp/freecad_flat
+
+``--parts DIR`` runs it on every ``*.step``/``*.stp`` in ``DIR`` instead (the torture set:
+``--parts ../shared/sheetmetal_torture``, then ``benchmarks/torture.py --freecad``); where ``DIR`` holds a
+``parts.csv`` with ``part`` and ``k_factor`` columns, each part listed there is unfolded with its own K-factor
+(``--k-factor`` is for the rest).
 
 On FreeCAD < 1.0 (Debian 12 packages 0.20.2) the workbench's ``FreeCAD.Base.Precision``
 is supplied with OpenCascade's own values (confusion 1e-7, angular 1e-12,
@@ -16,8 +23,9 @@ fixed face and unfolds with the workbench's new unfolder (``SheetMetalNewUnfolde
 K = 0.47, ANSI); this script writes what it returns as ``<out>/<part>.dxf`` (the cut
 contours on CUT, sampled within 0.001 mm; the bend lines on BEND) and
 ``<out>/<part>.json`` (the unfold's wall time alone, the versions, the bend count, or the
-error).  ``benchmarks/sheet_metal.py --freecad`` then compares these files with SolidWorks'
-flat patterns by the same code as ours.
+error, as one line: the exception FreeCAD raised, "no result: " and the last line FreeCAD printed when it
+stopped without one, or "timed out after N s").  ``benchmarks/sheet_metal.py --freecad`` then compares these files
+with SolidWorks' flat patterns by the same code as ours.
 """
 
 from __future__ import annotations
@@ -31,6 +39,9 @@ import tempfile
 from pathlib import Path
 
 SHEETMETAL = Path(__file__).resolve().parent.parent.parent / "shared" / "sheetmetal"
+SUFFIXES = (".step", ".stp")
+TIMEOUT = 600
+"""Seconds one part may take in ``freecadcmd``."""
 
 INSIDE_FREECAD = r'''
 import json, sys, time
@@ -71,7 +82,7 @@ try:
                          for b in bends]
     out["ok"] = True
 except Exception as exc:
-    out.update(ok=False, error=f"{type(exc).__name__}: {exc}")
+    out.update(ok=False, error=" ".join(f"{type(exc).__name__}: {exc}".split()))
 print("RESULT " + json.dumps(out))
 '''
 
@@ -81,6 +92,8 @@ def main(argv=None) -> int:
     parser.add_argument("--workbench", type=Path, required=True, help="a checkout of FreeCAD_SheetMetal")
     parser.add_argument("--out", type=Path, required=True, help="folder for the flat patterns (made if missing)")
     parser.add_argument("--k-factor", type=float, default=0.47)
+    parser.add_argument("--parts", type=Path, default=SHEETMETAL,
+                        help="folder of STEP parts (default: ../shared/sheetmetal)")
     args = parser.parse_args(argv)
     if shutil.which("freecadcmd") is None:
         print("freecadcmd is not on the PATH (Debian: apt-get install freecad)", file=sys.stderr)
@@ -88,24 +101,20 @@ def main(argv=None) -> int:
     if not (args.workbench / "SheetMetalNewUnfolder.py").is_file():
         print(f"{args.workbench}: not a FreeCAD_SheetMetal checkout (no SheetMetalNewUnfolder.py)", file=sys.stderr)
         return 2
-    if not SHEETMETAL.is_dir():
-        print(f"{SHEETMETAL} is absent", file=sys.stderr)
+    steps = sorted(p for p in args.parts.glob("*") if p.suffix.lower() in SUFFIXES) if args.parts.is_dir() else []
+    if not steps:
+        print(f"{args.parts}: no STEP parts there", file=sys.stderr)
         return 2
     import ezdxf
 
     commit = subprocess.run(["git", "-C", str(args.workbench), "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True, check=False).stdout.strip()
     args.out.mkdir(parents=True, exist_ok=True)
-    for step in sorted(SHEETMETAL.glob("*.STEP")):
-        with tempfile.TemporaryDirectory() as tmp:
-            script = Path(tmp) / "unfold.py"
-            script.write_text(f"WORKBENCH = {str(args.workbench)!r}\nSTEP = {str(step)!r}\nK = {args.k_factor!r}\n"
-                              + INSIDE_FREECAD)
-            proc = subprocess.run(["freecadcmd", str(script)], capture_output=True, text=True, timeout=600, check=False,
-                                  env={"QT_QPA_PLATFORM": "offscreen", "HOME": tmp, "PATH": "/usr/bin:/bin"})
-        found = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
-        result = json.loads(found[-1][7:]) if found else {"ok": False, "error": proc.stderr[-500:]}
-        result["workbench_commit"] = commit
+    k_factors = _k_factors(args.parts)
+    for step in steps:
+        k_factor = k_factors.get(step.stem, args.k_factor)
+        result = _run(step, args.workbench.resolve(), k_factor)
+        result.update(workbench_commit=commit, k_factor=k_factor)
         loops, bends = result.pop("loops", []), result.pop("bend_lines", [])
         result["bend_lines"] = len(bends)
         if result["ok"]:
@@ -121,6 +130,36 @@ def main(argv=None) -> int:
         print(f"{step.stem}: {'ok' if result['ok'] else 'FAILED ' + result.get('error', '')[:200]}, "
               f"{result.get('seconds', float('nan')):.2f} s, {result['bend_lines']} bend lines", flush=True)
     return 0
+
+
+def _k_factors(folder: Path) -> dict:
+    """``{part: K-factor}`` from ``folder/parts.csv`` (columns ``part`` and ``k_factor``), or ``{}`` without one."""
+    import csv
+
+    if not (folder / "parts.csv").is_file():
+        return {}
+    with open(folder / "parts.csv", newline="") as f:
+        return {row["part"]: float(row["k_factor"]) for row in csv.DictReader(f) if row.get("k_factor")}
+
+
+def _run(step: Path, workbench: Path, k_factor: float) -> dict:
+    """FreeCAD SheetMetal's unfold of one part, as the JSON record ``INSIDE_FREECAD`` prints (``ok``, and
+    ``error`` as one line when it fails)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        script = Path(tmp) / "unfold.py"
+        script.write_text(f"WORKBENCH = {str(workbench)!r}\nSTEP = {str(step.resolve())!r}\nK = {k_factor!r}\n"
+                          + INSIDE_FREECAD)
+        try:
+            proc = subprocess.run(["freecadcmd", str(script)], capture_output=True, text=True, timeout=TIMEOUT,
+                                  check=False, env={"QT_QPA_PLATFORM": "offscreen", "HOME": tmp, "PATH": "/usr/bin:/bin"})
+        except subprocess.TimeoutExpired:
+            return {"ok": False, "error": f"timed out after {TIMEOUT} s"}
+    found = [line for line in proc.stdout.splitlines() if line.startswith("RESULT ")]
+    if found:
+        return json.loads(found[-1][7:])
+    said = [line.strip() for line in proc.stderr.splitlines() if line.strip()]
+    cause = " ".join(said[-1].split())[:300] if said else f"freecadcmd exited with code {proc.returncode}"
+    return {"ok": False, "error": f"no result: {cause}"}
 
 
 if __name__ == "__main__":

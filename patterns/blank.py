@@ -18,10 +18,11 @@ from functools import cached_property
 import numpy as np
 import shapely
 
-from .curves import Loop, Motion
+from .bendsheet import bend_rows, sequence
+from .curves import Arc, Loop, Motion
 from .findings import Finding, Severity
 
-__all__ = ["Bend", "Blank"]
+__all__ = ["Bend", "Blank", "Rim"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,6 +72,63 @@ class Bend:
 
 
 @dataclass(frozen=True, eq=False)
+class Rim:
+    """The rim of a countersunk or counterbored hole: a circle to mark, not to cut.
+
+    The laser cuts the hole at its through diameter (one of the blank's holes); the countersink or
+    counterbore is machined afterwards, from the side the rim is on.
+
+    Attributes
+    ----------
+    circle : patterns.curves.Arc
+        The rim on the blank, a full counter-clockwise circle (centre (2,) float64, mm; radius mm).
+    through : float
+        The through hole's diameter, mm (the hole cut at the same centre).
+    kind : str
+        ``"countersink"`` (a cone from the rim down to the hole) or ``"counterbore"`` (a cylinder of the
+        rim's diameter down to a flat step).
+    side : str
+        ``"near"``: on the fixed face's side of the sheet (the side the blank is drawn from, as a bend's
+        direction is seen); ``"far"``: on the other side.
+    depth : float
+        How deep the countersink or counterbore goes from the rim's side, mm.
+    angle : float or None
+        A countersink's included angle, degrees (90 for a 90° countersink); None for a counterbore.
+    face : int
+        The planar CAD face the hole is in (``shape.faces()`` index).
+    """
+
+    circle: Arc
+    through: float
+    kind: str
+    side: str
+    depth: float
+    angle: float | None
+    face: int
+
+    @property
+    def center(self) -> np.ndarray:
+        """(2,) float64, mm."""
+        return self.circle.center
+
+    @property
+    def diameter(self) -> float:
+        """The rim's diameter, mm."""
+        return 2 * self.circle.radius
+
+    def moved(self, motion: Motion) -> Rim:
+        circle = self.circle.moved(motion)
+        return replace(self, circle=circle.reversed() if motion.mirrored else circle)
+
+    def to_dict(self) -> dict:
+        """JSON-ready: centre, diameters and depth in mm, the angle in degrees."""
+        return {"kind": self.kind, "side": self.side, "center": np.round(self.center, 4).tolist(),
+                "diameter_mm": round(self.diameter, 4), "through_mm": round(self.through, 4),
+                "depth_mm": round(self.depth, 4), "angle_deg": None if self.angle is None else round(self.angle, 3),
+                "face": self.face}
+
+
+@dataclass(frozen=True, eq=False)
 class Blank:
     """The flat blank of a sheet-metal part (:func:`patterns.unfold`).
 
@@ -80,7 +138,8 @@ class Blank:
     outline : patterns.curves.Loop
         The outer contour, counter-clockwise.
     holes : tuple of patterns.curves.Loop
-        Every hole and cut-out, clockwise; drilled holes as one full-circle :class:`~patterns.curves.Arc`.
+        Every hole and cut-out, clockwise; drilled holes as one full-circle :class:`~patterns.curves.Arc`, a
+        countersunk or counterbored one at its through diameter (its rim is in ``rims``).
     bends : tuple of Bend
     thickness : float
         Sheet thickness read from the model, mm.
@@ -91,6 +150,11 @@ class Blank:
     findings : tuple of patterns.Finding
         Errors (``flanges-overlap``: the blank cannot be cut as it is) and notes
         (``bend-without-flange``, ``meshed-face``), as :func:`patterns.check` reports them.
+    material : str or None
+        The material whose table gave each bend its K-factor (``material=``), or None.
+    rims : tuple of Rim
+        The rims of countersunk and counterbored holes: marked, not cut (the hole is cut at its through
+        diameter, one of ``holes``).
     """
 
     name: str
@@ -101,6 +165,8 @@ class Blank:
     k_factor: float | None
     fixed_face: int
     findings: tuple
+    material: str | None = None
+    rims: tuple = ()
 
     @property
     def ok(self) -> bool:
@@ -134,24 +200,34 @@ class Blank:
         w, h = self.size
         return self.area / (w * h) if w * h > 0 else 0.0
 
+    def bend_sheet(self) -> tuple:
+        """The press brake's bend sheet: one :class:`~patterns.bendsheet.BendRow` per bend, in the order to
+        bend them (outside-in, :func:`patterns.bendsheet.sequence`), lengths in mm, the bend lines' ends in
+        the blank's own coordinates (``patterns.write(blank, "bends.csv")`` writes them in the DXF's)."""
+        return bend_rows(self.name, self.polygon, self.bends)
+
     def moved(self, motion: Motion) -> Blank:
-        """The blank moved rigidly (as laid out in a drawing or nested): outline, holes, bend lines and the
+        """The blank moved rigidly (as laid out in a drawing or nested): outline, holes, rims, bend lines and the
         findings' points; nothing is scaled."""
         findings: tuple[Finding, ...] = tuple(f.moved(motion) for f in self.findings)
         return replace(self, outline=self.outline.moved(motion), holes=tuple(h.moved(motion) for h in self.holes),
-                       bends=tuple(b.moved(motion) for b in self.bends), findings=findings)
+                       bends=tuple(b.moved(motion) for b in self.bends), findings=findings,
+                       rims=tuple(r.moved(motion) for r in self.rims))
 
     def to_dict(self) -> dict:
         """Size, area, usage, bends and findings, JSON-ready (the report's ``blanks`` entries)."""
         w, h = self.size
+        rank = {i: k for k, i in enumerate(sequence(self.polygon, [b.line for b in self.bends]), start=1)}
         return {
             "name": self.name, "ok": self.ok, "thickness_mm": round(self.thickness, 4),
             "k_factor": self.k_factor, "fixed_face": self.fixed_face,
             "size_mm": [round(w, 3), round(h, 3)], "area_mm2": round(self.area, 3),
             "outer_perimeter_mm": round(self.perimeter, 3), "holes": len(self.holes),
             "usage": round(self.usage, 4),
-            "bends": [{"angle_deg": round(b.angle, 3), "inside_radius_mm": round(b.inside_radius, 4),
+            "material": self.material,
+            "bends": [{"sequence": rank[i], "angle_deg": round(b.angle, 3), "inside_radius_mm": round(b.inside_radius, 4),
                        "direction": b.direction, "allowance_mm": round(b.allowance, 4), "k_factor": b.k_factor,
-                       "line": np.round(b.line, 4).tolist(), "faces": list(b.faces)} for b in self.bends],
+                       "line": np.round(b.line, 4).tolist(), "faces": list(b.faces)} for i, b in enumerate(self.bends)],
+            "rims": [r.to_dict() for r in self.rims],
             "findings": [f.to_dict() for f in self.findings],
         }

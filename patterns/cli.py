@@ -10,8 +10,8 @@ Subcommands::
     patterns demo [-o DIR]
     patterns batch DIR -o OUTDIR [--jobs N] [--scheduler ADDRESS] [--timeout S] [--report] [--preview]
                    [--unfold [--k-factor K | --bend-table CSV]]
-    patterns unfold PART.STEP -o BLANK.dxf [--k-factor K] [--bend-table CSV] [--fixed-face N]
-                    [--report OUT.json] [--compare THEIRS.dxf] [--sheet LxW --copies N] [--layer-map MAP]
+    patterns unfold PART.STEP -o BLANK.dxf [--k-factor K | --bend-table CSV | --material NAME] [--fixed-face N]
+                    [--report OUT.json] [--bend-sheet BENDS.csv] [--compare THEIRS.dxf] [--sheet LxW --copies N] [--layer-map MAP]
 
 Every run plans, then works, then commits: every option, the input and every
 output are checked before any work (one line, exit 2, nothing written); the
@@ -126,6 +126,9 @@ def _parser() -> argparse.ArgumentParser:
     unf.add_argument("--report", type=Path, default=None,
                      help="write the JSON report here (bends, size, usage, the blank as drawn, in the DXF's frame)")
     unf.add_argument("--preview", type=Path, default=None, help="render the written DXF at 1:1 (.png or .svg)")
+    unf.add_argument("--bend-sheet", type=Path, default=None, metavar="CSV",
+                     help="write the bend sheet for the press brake here (.csv): a row per bend in the order to bend "
+                          "them, with direction, angle, radius, length, K-factor, allowance and the line on the DXF")
     unf.add_argument("--compare", type=Path, default=None, metavar="DXF",
                      help="a flat pattern of the same part from another CAD program: print how far ours lies from it")
     output(unf, blank=True)
@@ -451,7 +454,8 @@ def _cmd_unfold(args) -> int:
     inputs = inputs_of(args.input, records) + ([args.compare] if args.compare is not None else [])
     if args.compare is not None:
         check_input_file(args.compare, what="DXF file")
-    planned = plan_outputs({"pattern": args.output, "report": args.report, "preview": args.preview}, inputs=inputs,
+    planned = plan_outputs({"pattern": args.output, "report": args.report, "preview": args.preview,
+                            "bend_sheet": args.bend_sheet}, inputs=inputs,
                            suffixes={"pattern": (".dxf", ".svg")}, profile=records["write"].profile)
     reference = read_flat_pattern(args.compare) if args.compare is not None else None
     with Outputs(inputs=inputs) as out:
@@ -464,9 +468,9 @@ def _cmd_unfold(args) -> int:
           f"{counted(len(blank.holes), 'hole')}; "
           f"blank {w:.2f} x {h:.2f} mm, area {blank.area:.1f} mm2, usage {blank.usage:.1%} (read and unfolded in "
           f"{part.seconds['flatten']:.2f} s)")
-    rows = [("bend", "direction", "angle deg", "inside R mm", "allowance mm")]
-    rows += [(str(k), b.direction, f"{b.angle:.2f}", f"{b.inside_radius:g}", f"{b.allowance:.4f}")
-             for k, b in enumerate(blank.bends)]
+    rows = [("bend", "direction", "angle deg", "inside R mm", "length mm", "K", "allowance mm")]  # in sequence
+    rows += [(str(r.sequence), r.direction, f"{r.angle_deg:.2f}", f"{r.inside_radius_mm:g}", f"{r.bend_length_mm:.2f}",
+              "table" if r.k_factor is None else f"{r.k_factor:g}", f"{r.allowance_mm:.4f}") for r in blank.bend_sheet()]
     if blank.bends:
         _table(rows)
     for f in blank.findings:
@@ -477,7 +481,7 @@ def _cmd_unfold(args) -> int:
               f" mm, holes {c.holes}/{c.holes_reference}, bend lines {c.bend_lines}/{c.bend_lines_reference}, outline "
               f"Hausdorff {c.hausdorff:.3f} mm ({c.within:.1%} of it within 0.1 mm)")
     if not blank.ok:
-        print(f"{args.output}: not written (the blank cannot be cut as it is)")
+        print(f"{', '.join(map(str, planned.values()))}: not written (the blank cannot be cut as it is)")
         return EXIT_CHECK
     _nested(part.nest)
     _wrote(_Run(planned, part), records)

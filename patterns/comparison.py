@@ -5,6 +5,12 @@ cut before.  :func:`read_flat_pattern` reads such a DXF -- its cut contours
 (LINE, ARC, CIRCLE, polylines with bulges, chained end to end; arcs sampled
 exactly) and its bend lines (a BEND layer, or any line not drawn continuous:
 SolidWorks' centre lines, our dashed ones) -- and
+:func:`compare_blank` sets the two side by side.  A contour lying inside a
+hole (SolidWorks draws a countersunk or counterbored hole as two concentric
+circles) is that hole's rim: the inner contour is the hole the laser cuts, the
+outer is machined afterwards, so the area is the outline less the inner ones.
+A contour the drawing leaves open is an error, or, with
+``open_contours="leave-out"``, left out and recorded.  Then
 :func:`compare_blank` sets the two side by side: area, outer perimeter, holes,
 bend lines, and how far the outlines lie apart once the best rigid motion
 (mirror allowed: a blank may be drawn from either side) has put one on the
@@ -15,7 +21,7 @@ from __future__ import annotations
 
 import itertools
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -39,14 +45,23 @@ class FlatPattern:
     outline : (k, 2) float64, mm
         The outer contour (counter-clockwise, not closed).
     holes : tuple of (j, 2) float64, mm
+        The holes cut (clockwise): of a countersunk or counterbored hole, the inner contour.
     bend_lines : (b, 2, 2) float64, mm
+    path : str
+        The file it was read from.
+    rims : tuple of (j, 2) float64, mm
+        Contours lying inside a hole (clockwise): a countersink's or counterbore's rim, not cut.
+    open_contours : (n, 2, 2) float64, mm
+        The two end points of every chain of pieces that does not close, left out
+        (``open_contours="leave-out"``).
     """
 
     outline: np.ndarray
     holes: tuple
     bend_lines: np.ndarray
     path: str = ""
-    """The file it was read from."""
+    rims: tuple = ()
+    open_contours: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)))
 
     @property
     def polygon(self) -> shapely.Polygon:
@@ -110,22 +125,37 @@ def _pieces(entity, tolerance: float):
     return None
 
 
-def read_flat_pattern(path, *, tolerance: float = 0.001) -> FlatPattern:
+OPEN_CONTOURS = ("error", "leave-out")
+"""What :func:`read_flat_pattern` does with a chain of pieces that does not close."""
+
+
+def read_flat_pattern(path, *, tolerance: float = 0.001, open_contours: str = "error") -> FlatPattern:
     """Read a flat pattern's contours and bend lines from a DXF file (model space, in its own unit).
+
+    The largest closed contour is the outline; a contour inside another one that lies inside the outline is
+    a hole, and the one around it a rim (a countersunk or counterbored hole drawn as two concentric
+    circles: the laser cuts the inner, the rim is machined afterwards).
 
     Parameters
     ----------
     path : str or Path
     tolerance : float
         Chord error of arcs and curves sampled as points, mm.
+    open_contours : {"error", "leave-out"}
+        A chain of pieces that does not close: an InputError naming where it stops (``"error"``), or left
+        out and its end points recorded in :attr:`FlatPattern.open_contours` (``"leave-out"``).
 
     Raises
     ------
     InputError
-        Not a readable DXF, or contours that do not close.
+        Not a readable DXF, contours that do not close (unless left out), no closed contour, or an
+        unknown ``open_contours``.
     """
     import ezdxf
 
+    if open_contours not in OPEN_CONTOURS:
+        raise InputError(f"{path}: open_contours must be one of {', '.join(map(repr, OPEN_CONTOURS))}, got "
+                         f"{open_contours!r}")
     try:
         doc = ezdxf.readfile(str(path))
     except (OSError, ezdxf.DXFError) as exc:
@@ -139,24 +169,48 @@ def read_flat_pattern(path, *, tolerance: float = 0.001) -> FlatPattern:
         if got is None:
             continue
         (closed if got[0] else open_).append(got[1])
-    loops = closed + _chain(open_, path)
+    chained, left_out = _chain(open_, path, leave_out=open_contours == "leave-out")
+    loops = closed + chained
     if not loops:
-        raise InputError(f"{path}: no closed contour")
+        raise InputError(f"{path}: no closed contour" + (f" ({len(left_out)} open left out)" if left_out else ""))
     polys = [shapely.Polygon(lp) for lp in loops]
     outer = int(np.argmax([p.area for p in polys]))
     outline = np.array(shapely.geometry.polygon.orient(polys[outer], 1.0).exterior.coords)[:-1]
-    holes = tuple(np.array(shapely.geometry.polygon.orient(p, 1.0).exterior.coords)[-2::-1]
-                  for k, p in enumerate(polys) if k != outer)
-    return FlatPattern(outline, holes, np.array(bends).reshape(-1, 2, 2), os.fsdecode(path))
+    inner = [k for k in range(len(polys)) if k != outer]
+    others = np.array([polys[k] for k in inner], dtype=object)
+    around, _ = shapely.STRtree(others).query(others, predicate="contains_properly")  # holds another contour
+    rims = {inner[a] for a in around}
+
+    def clockwise(p):
+        return np.array(shapely.geometry.polygon.orient(p, 1.0).exterior.coords)[-2::-1]
+
+    return FlatPattern(outline, tuple(clockwise(polys[k]) for k in inner if k not in rims),
+                       np.array(bends).reshape(-1, 2, 2), os.fsdecode(path),
+                       rims=tuple(clockwise(polys[k]) for k in inner if k in rims),
+                       open_contours=np.array(left_out).reshape(-1, 2, 2))
 
 
-def _chain(pieces, path):
-    """Join open pieces end to end into closed loops."""
+def _chain(pieces, path, *, leave_out: bool = False):
+    """Join open pieces end to end into closed loops: ``(loops, left out)``, ``left out`` the two end points
+    ((2, 2) mm) of every chain that does not close, when ``leave_out`` (else an InputError)."""
     pieces = [p for p in pieces if len(p) >= 2]
-    loops = []
+    loops, left_out = [], []
     used = np.zeros(len(pieces), bool)
     starts = np.array([p[0] for p in pieces]).reshape(-1, 2)
     ends = np.array([p[-1] for p in pieces]).reshape(-1, 2)
+
+    def take(at):
+        """The unused piece that goes on from ``at``, turned to start there (marked used), or None."""
+        free = np.flatnonzero(~used)
+        if len(free) == 0:
+            return None
+        ds, de = np.linalg.norm(starts[free] - at, axis=1), np.linalg.norm(ends[free] - at, axis=1)
+        j = int(np.argmin(np.minimum(ds, de)))
+        if min(ds[j], de[j]) > _JOIN:
+            return None
+        used[free[j]] = True
+        return pieces[free[j]] if ds[j] <= de[j] else pieces[free[j]][::-1]
+
     for k in range(len(pieces)):
         if used[k]:
             continue
@@ -164,21 +218,21 @@ def _chain(pieces, path):
         loop = [pieces[k]]
         first, at = pieces[k][0], pieces[k][-1]
         while np.linalg.norm(at - first) > _JOIN:
-            free = np.flatnonzero(~used)
-            if len(free) == 0:
-                raise InputError(f"{path}: a contour does not close (open end at x {at[0]:.3f}, y {at[1]:.3f})")
-            ds, de = np.linalg.norm(starts[free] - at, axis=1), np.linalg.norm(ends[free] - at, axis=1)
-            j = int(np.argmin(np.minimum(ds, de)))
-            if min(ds[j], de[j]) > _JOIN:
-                raise InputError(f"{path}: a contour does not close (open end at x {at[0]:.3f}, y {at[1]:.3f})")
-            i = free[j]
-            used[i] = True
-            piece = pieces[i] if ds[j] <= de[j] else pieces[i][::-1]
+            piece = take(at)
+            if piece is None:
+                if not leave_out:
+                    raise InputError(f"{path}: a contour does not close (open end at x {at[0]:.3f}, y {at[1]:.3f}; "
+                                     f"open_contours='leave-out' reads the rest)")
+                while (back := take(first)) is not None:  # the chain's other end: the pieces before its first
+                    first = back[-1]
+                left_out.append(np.array([first, at]))
+                break
             loop.append(piece[1:])
             at = piece[-1]
-        pts = np.concatenate(loop)
-        loops.append(pts[:-1] if np.linalg.norm(pts[-1] - pts[0]) <= _JOIN else pts)
-    return loops
+        else:
+            pts = np.concatenate(loop)
+            loops.append(pts[:-1] if np.linalg.norm(pts[-1] - pts[0]) <= _JOIN else pts)
+    return loops, left_out
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,6 +255,13 @@ class BlankComparison:
         The share of our outer contour (by length) within 0.1 mm of theirs.
     mirrored : bool
         The reference is drawn from the other side of the sheet.
+    rims, rims_reference : int
+        Countersinks' and counterbores' rims (:attr:`patterns.Blank.rims`, :attr:`FlatPattern.rims`).
+    hausdorff_rims : float or None
+        Largest distance between the two sets of rims after the same alignment, mm; None unless both
+        have rims.
+    open_contours_reference : int
+        Open chains the reference was read without (``open_contours="leave-out"``).
     """
 
     area: float
@@ -215,6 +276,10 @@ class BlankComparison:
     hausdorff_all: float
     within: float
     mirrored: bool
+    rims: int = 0
+    rims_reference: int = 0
+    hausdorff_rims: float | None = None
+    open_contours_reference: int = 0
 
     @property
     def area_error(self) -> float:
@@ -226,7 +291,9 @@ class BlankComparison:
         return {"reference": reference, "area_error": self.area_error, "perimeter_mm": self.perimeter,
                 "perimeter_reference_mm": self.perimeter_reference, "holes_reference": self.holes_reference,
                 "bend_lines_reference": self.bend_lines_reference, "hausdorff_mm": self.hausdorff,
-                "hausdorff_all_mm": self.hausdorff_all, "within_0.1mm": self.within, "mirrored": self.mirrored}
+                "hausdorff_all_mm": self.hausdorff_all, "within_0.1mm": self.within, "mirrored": self.mirrored,
+                "rims": self.rims, "rims_reference": self.rims_reference, "hausdorff_rims_mm": self.hausdorff_rims,
+                "open_contours_reference": self.open_contours_reference}
 
 
 def _resample(loop: np.ndarray, step: float) -> np.ndarray:
@@ -254,6 +321,9 @@ def _align(ours: np.ndarray, theirs: np.ndarray):
         d = tree.query(ours @ rot.T + shift)[0]
         return d[d <= np.quantile(d, 0.9)].mean()
 
+    def whole(rot, shift):
+        return tree.query(ours @ rot.T + shift)[0].mean()
+
     ca, cb = ours.mean(axis=0), theirs.mean(axis=0)
     _, va = np.linalg.eigh(np.cov((ours - ca).T))
     _, vb = np.linalg.eigh(np.cov((theirs - cb).T))
@@ -275,8 +345,10 @@ def _align(ours: np.ndarray, theirs: np.ndarray):
                 break
         return rot, shift
 
-    tried = [icp(rot, shift, 30) for rot, shift in starts]  # a few rounds from each start, then on from the best
-    rot, shift = icp(*min(tried, key=lambda rs: trimmed(*rs)), 300)
+    # a few rounds from each start, then on from the one nearest over ALL the points: a nearly symmetric part
+    # (an H whose two notches differ) fits its mirror image well on nine tenths of its points, but not on all
+    tried = [icp(rot, shift, 30) for rot, shift in starts]
+    rot, shift = icp(*min(tried, key=lambda rs: whole(*rs)), 300)
     best = (trimmed(rot, shift), rot, shift)
     _, rot, shift = best
     mirror = np.diag([1.0, np.sign(np.linalg.det(rot))])
@@ -298,7 +370,8 @@ def compare_blank(blank, reference) -> BlankComparison:
     The contours (outline and holes) are aligned by a rigid motion (a mirror allowed), fitted
     by trimmed iterative closest points (the worst tenth of the pairs left out, so
     that one corner drawn differently does not shift the rest) and a simplex polish; the Hausdorff distance is then measured on contours resampled
-    every 0.02 mm.
+    every 0.02 mm.  Holes are compared with holes (of a countersunk hole, the through hole) and rims with
+    rims; the reference's open contours, when it was read without them, are counted.
     """
     from scipy.spatial import cKDTree
 
@@ -306,9 +379,10 @@ def compare_blank(blank, reference) -> BlankComparison:
     if isinstance(blank, (str, Path)):
         ours = read_flat_pattern(blank)
         outline, holes, bends = ours.outline, ours.holes, len(ours.bend_lines)
-        area, perimeter = ours.area, ours.perimeter
+        area, perimeter, rims = ours.area, ours.perimeter, ours.rims
     else:
         outline, holes = blank.outline.points(), tuple(h.points() for h in blank.holes)
+        rims = tuple(r.circle.points()[:-1] for r in blank.rims)
         bends, area, perimeter = len(blank.bends), blank.area, blank.perimeter
     rot, shift = _align(np.vstack([_resample(lp, 0.5) for lp in (outline, *holes)]),
                         np.vstack([_resample(lp, 0.02) for lp in (ref.outline, *ref.holes)]))
@@ -319,6 +393,7 @@ def compare_blank(blank, reference) -> BlankComparison:
         return cKDTree(b).query(a)[0], cKDTree(a).query(b)[0]
 
     there, back = distances([outline], [ref.outline])
+    rims_off = float(max(d.max() for d in distances(rims, ref.rims))) if rims and ref.rims else None
 
     return BlankComparison(
         area=area, area_reference=ref.area, perimeter=perimeter, perimeter_reference=ref.perimeter,
@@ -326,4 +401,5 @@ def compare_blank(blank, reference) -> BlankComparison:
         hausdorff=float(max(there.max(), back.max())),
         hausdorff_all=float(max(d.max() for d in distances([outline, *holes], [ref.outline, *ref.holes]))),
         within=float(np.mean(there <= 0.1)),
-        mirrored=bool(np.linalg.det(rot) < 0))
+        mirrored=bool(np.linalg.det(rot) < 0), rims=len(rims), rims_reference=len(ref.rims), hausdorff_rims=rims_off,
+        open_contours_reference=len(ref.open_contours))

@@ -56,6 +56,23 @@ class Code(str, Enum):
     LABEL_LEFT_OUT = "label-left-out"
     """A label (a piece's name, a seam's or a bend's) that fits nowhere on its piece at the least text height:
     left out of the drawing rather than drawn smaller or across a cut."""
+    OUTLINE_CUSP = "outline-cusp"
+    """A blank's cut contour turning back on itself (a spike of material, or a notch, sharper than
+    ``patterns.sheetmetal.contour.CUSP_DEGREES``): a corner developed as the model has it
+    (``corner_relief="as-modelled"``) or a face drawn to a point."""
+    OUTLINE_TOUCHES_ITSELF = "outline-touches-itself"
+    """A blank's cut contours touch or cross one another: the part would fall apart, or cannot be cut."""
+    SLIVER = "sliver"
+    """A strip of a blank narrower than half the sheet's thickness: it burns away or bends under the cut."""
+    HOLE_NEAR_BEND = "hole-near-bend"
+    """A hole of a blank closer to a bend's zone than half the V-die from its centre line (or 1.5 t): the
+    press brake draws it out of shape (:mod:`patterns.sheetmetal.rules`)."""
+    SHORT_FLANGE = "short-flange"
+    """A flange of a blank too short to rest on the shoulder of a 6 t V-die through the bend."""
+    MISSING_RELIEF = "missing-relief"
+    """A bend that ends against unbent material of its blank with no relief cut there: the corner tears."""
+    OPEN_CONTOUR = "open-contour"
+    """A cut contour of a blank that does not close: an error, a cutter must never get one."""
 
 
 @dataclass(frozen=True, eq=False)

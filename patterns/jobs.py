@@ -54,21 +54,26 @@ OUTPUT_KINDS = {
     "report": ((".json",), "report"),
     "heat_map": ((".png", ".svg"), "heat map"),
     "preview": ((".png", ".svg"), "preview"),
+    "bend_sheet": ((".csv",), "bend sheet"),
 }
 """What a run writes: ``{kind: (suffixes, what it is called in messages)}``, in the order written."""
 
-_FLAGS = {"pattern": "-o", "report": "--report", "heat_map": "--heat-map", "preview": "--preview"}
+_FLAGS = {"pattern": "-o", "report": "--report", "heat_map": "--heat-map", "preview": "--preview",
+          "bend_sheet": "--bend-sheet"}
 
 _DXF = ("machine", "astm")
 """Profiles that only choose the DXF's dialect: with another output suffix they are not asked for."""
 
 
 def inputs_of(source, records: dict) -> list:
-    """Every file a run reads: the part, and a bend table when one is given (no output may name them)."""
+    """Every file a run reads: the part, and a bend table or a material table when one is given (no output may
+    name them)."""
     out = [Path(source)]
     unfolding = records.get("unfold")
     if unfolding is not None and unfolding.bend_table is not None:
         out.append(Path(unfolding.bend_table.path))
+    if unfolding is not None and unfolding.material_table is not None and unfolding.material_table.path:
+        out.append(Path(unfolding.material_table.path))
     return out
 
 
@@ -201,6 +206,8 @@ def _write(subject, drawing: Drawing, checked: Drawing, records: dict, outputs: 
             write(checked, tmp, replace(options, profile="json"))
         elif kind == "heat_map":
             heat_map(subject, tmp)
+        elif kind == "bend_sheet":
+            write(drawing, tmp, replace(options, profile="bends"))  # the bend lines where the DXF draws them
         else:
             dpi = preview_dxf(written["pattern"], tmp)
         written[kind] = tmp

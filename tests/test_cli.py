@@ -414,6 +414,6 @@ def test_a_pattern_is_never_written_under_a_suffix_of_another_format(tmp_path):
     pattern = patterns.flatten(patterns.load(SAMPLES / "cone.obj"))
     for name in ("x.pdf", "x.DXF.pdf", "x", "x.png"):
         with pytest.raises(patterns.InputError, match=r"cannot write '(\.pdf|\.png|\(no suffix\))' files; "
-                                                      r"write \.dxf, \.json, \.svg"):
+                                                      r"write \.csv, \.dxf, \.json, \.svg"):
             patterns.write(pattern, tmp_path / name)
     assert not list(tmp_path.iterdir())

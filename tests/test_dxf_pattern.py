@@ -394,7 +394,7 @@ def test_a_per_seam_allowance_is_bounded_too(cup, tmp_path):
 @pytest.mark.parametrize(
     ("kwargs", "words"),
     [
-        ({"profile": "gerber"}, "profile must be one of machine, astm, svg, json, got .gerber."),
+        ({"profile": "gerber"}, "profile must be one of machine, astm, svg, json, bends, got .gerber."),
         ({"units": "furlong"}, "units must be one of mm, cm, m, in"),
         ({"version": "R14"}, "version must be one of R12, R2000"),
         ({"profile": "astm", "version": "R2000"}, "R12 only"),

@@ -108,9 +108,9 @@ def test_a_registered_profile_writes_pieces_of_patterns_and_blanks(cup, bracket,
             register(Profile("toy", ".toy", _toy_write, "again"))
     finally:
         unregister("toy")
-    with pytest.raises(InputError, match="profile must be one of machine, astm, svg, json, got 'toy'"):
+    with pytest.raises(InputError, match="profile must be one of machine, astm, svg, json, bends, got 'toy'"):
         patterns.WriteOptions(profile="toy")
-    with pytest.raises(InputError, match="cannot write '.toy' files; write .dxf, .json, .svg"):
+    with pytest.raises(InputError, match="cannot write '.toy' files; write .csv, .dxf, .json, .svg"):
         patterns.write(cup, tmp_path / "y.toy")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["parts.toy"]
 

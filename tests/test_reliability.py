@@ -556,7 +556,7 @@ def test_the_longest_legal_output_name(here, capfd):
 
 
 @pytest.mark.parametrize(("flag", "value", "said"), [
-    ("--profile", "foo", "profile must be one of machine, astm, svg, json, got 'foo'"),  # the registered profiles
+    ("--profile", "foo", "profile must be one of machine, astm, svg, json, bends, got 'foo'"),  # the registered profiles
     ("--method", "fast", "(choose from 'relaxed', 'isometric', 'conformal')")])
 def test_a_bad_choice_is_one_line_with_the_choices(here, capfd, flag, value, said):
     refused(["flatten", "dish.obj", "-o", "d.dxf", flag, value], here, capfd, said)

@@ -3,19 +3,20 @@
 Every line of a piece has a *role*: ``cut`` (the outline), ``hole`` (a
 cut-out), ``sew``, ``notch``, ``grain``, ``drill``, ``bend_up`` and
 ``bend_down`` (a blank's bends, by the way the flange turns), ``bend`` (a
-ruling of a rolled panel, bumped either way), ``label``, ``strain`` and
-``stock``.  A :class:`LayerMap` gives each role a layer (name, AutoCAD colour
+ruling of a rolled panel, bumped either way), ``label``, ``strain``,
+``stock`` and ``countersink`` (the rim of a countersunk or counterbored hole:
+marked, not cut; the hole itself is a ``hole`` at its through diameter).  A :class:`LayerMap` gives each role a layer (name, AutoCAD colour
 index, linetype).  Flattened patterns and unfolded blanks use the same map;
 the presets:
 
 * ``patterns`` (default): ``CUT`` 1 red, ``SEW`` 5, ``NOTCH`` 6, ``GRAIN`` 3,
   ``BEND`` 2 dashed (every bend), ``DRILL`` 4, ``LABEL`` 7, ``STRAIN`` 8,
-  ``STOCK`` 9;
+  ``STOCK`` 9, ``COUNTERSINK`` 4;
 * ``updown``: as ``patterns``, with ``BEND_UP`` and ``BEND_DOWN`` by direction
   (FreeCAD SheetMetal issue 551);
-* ``solidworks``: outline and holes on ``0`` (colour 7), as SolidWorks writes
-  its flat patterns, bend lines on ``BEND`` in SolidWorks' ``CENTERX2``
-  linetype;
+* ``solidworks``: outline, holes and countersinks' rims on ``0`` (colour 7),
+  as SolidWorks writes its flat patterns, bend lines on ``BEND`` in
+  SolidWorks' ``CENTERX2`` linetype;
 * ``inventor``: Autodesk Inventor's flat-pattern layers (``IV_OUTER_PROFILE``,
   ``IV_INTERIOR_PROFILES``, ``IV_BEND``, ``IV_BEND_DOWN``, ``IV_ROLL``).
 
@@ -32,7 +33,8 @@ from ..errors import InputError
 
 __all__ = ["LINETYPES", "PRESETS", "ROLES", "Layer", "LayerMap", "layer_map"]
 
-ROLES = ("cut", "hole", "sew", "notch", "grain", "drill", "bend", "bend_up", "bend_down", "label", "strain", "stock")
+ROLES = ("cut", "hole", "sew", "notch", "grain", "drill", "bend", "bend_up", "bend_down", "label", "strain", "stock",
+         "countersink")
 """What a line on a piece is, in the order layers are declared."""
 
 LINETYPES = {
@@ -54,12 +56,14 @@ class Layer:
 _BASE = {"cut": Layer("CUT", 1), "hole": Layer("CUT", 1), "sew": Layer("SEW", 5), "notch": Layer("NOTCH", 6),
          "grain": Layer("GRAIN", 3), "drill": Layer("DRILL", 4), "bend": Layer("BEND", 2, "DASHED"),
          "bend_up": Layer("BEND", 2, "DASHED"), "bend_down": Layer("BEND", 2, "DASHED"),
-         "label": Layer("LABEL", 7), "strain": Layer("STRAIN", 8), "stock": Layer("STOCK", 9)}
+         "label": Layer("LABEL", 7), "strain": Layer("STRAIN", 8), "stock": Layer("STOCK", 9),
+         "countersink": Layer("COUNTERSINK", 4)}
 
 PRESETS = {
     "patterns": _BASE,
     "updown": {**_BASE, "bend_up": Layer("BEND_UP", 2, "DASHED"), "bend_down": Layer("BEND_DOWN", 30, "DASHED")},
-    "solidworks": {**_BASE, "cut": Layer("0", 7), "hole": Layer("0", 7), "bend": Layer("BEND", 7, "CENTERX2"),
+    "solidworks": {**_BASE, "cut": Layer("0", 7), "hole": Layer("0", 7), "countersink": Layer("0", 7),
+                   "bend": Layer("BEND", 7, "CENTERX2"),
                    "bend_up": Layer("BEND", 7, "CENTERX2"), "bend_down": Layer("BEND", 7, "CENTERX2")},
     "inventor": {**_BASE, "cut": Layer("IV_OUTER_PROFILE", 7), "hole": Layer("IV_INTERIOR_PROFILES", 7),
                  "bend": Layer("IV_ROLL", 2, "DASHED"), "bend_up": Layer("IV_BEND", 2, "DASHED"),

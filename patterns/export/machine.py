@@ -1,7 +1,8 @@
 """The DXF machine profile: for lasers, plasma and waterjet cutters and knife plotters.
 
 Every cut contour is ONE closed polyline (an arc a bulge, a drilled hole a
-CIRCLE) on the ``cut`` role's layer, never duplicated; marks and texts go on
+CIRCLE) on the ``cut`` role's layer, never duplicated (a countersunk hole's
+rim is a CIRCLE on the ``countersink`` role's layer); marks and texts go on
 layers of their own (:mod:`~patterns.export.layers`: one convention for
 patterns and blanks, or a shop's layer map), bend lines dashed.  z = 0, 1:1,
 ``$INSUNITS`` and ``$MEASUREMENT`` declared (R12 too, which predates them), the
@@ -12,10 +13,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..curves import Loop
 from ..files import atomic_output
 from ..pieces import Drawing, Piece, piece_labels
 from ..pieces.allowance import straight_runs
 from ..units import Unit
+from .bendsheet import sequenced
 from .dxfdoc import add_loop, add_polyline, add_text, declare_linetypes, new_doc, r12_units, save
 from .layers import LayerMap
 from .options import WriteOptions
@@ -37,6 +40,8 @@ def _roles(drawing: Drawing, options: WriteOptions) -> list:
         out.append("strain")
     if drawing.stock:
         out.append("stock")
+    if any(p.rims for p in drawing.pieces):
+        out.append("countersink")
     return out
 
 
@@ -61,6 +66,7 @@ def _strain_solids(msp, piece: Piece, layer: str, scale: float, truecolor: bool)
 
 def _piece(msp, piece: Piece, layers: LayerMap, unit: Unit, options: WriteOptions, r12: bool) -> None:
     scale = 1.0 / unit.mm
+    piece = sequenced(piece)  # a blank's bend labels numbered in the bending sequence
 
     def line(a, b, layer):
         msp.add_line(tuple(np.asarray(a) * scale), tuple(np.asarray(b) * scale), dxfattribs={"layer": layer})
@@ -77,6 +83,9 @@ def _piece(msp, piece: Piece, layers: LayerMap, unit: Unit, options: WriteOption
         for notch in piece.notches:  # a slit from the cut line to its tip, or a V from its tip to its mouth
             for a, b in ([(notch.at, notch.tip)] if notch.mouth is None else [(notch.tip, e) for e in notch.mouth]):
                 line(a, b, layers["notch"].name)
+    if layers["countersink"] is not None:  # a countersink's or counterbore's rim: a circle to mark, not cut
+        for rim in piece.rims:
+            add_loop(msp, Loop((rim.circle,)), layers["countersink"].name, scale=scale, r12=r12)
     if layers["drill"] is not None:
         for tip in piece.drills:
             msp.add_point(tuple(tip * scale), dxfattribs={"layer": layers["drill"].name})

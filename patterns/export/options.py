@@ -32,7 +32,8 @@ class WriteOptions(Options):
     """How a drawing is written (:func:`patterns.write`, ``patterns flatten -o``, ``patterns unfold -o``)."""
 
     profile: str | None = option(None, "output profile: machine (DXF for lasers, plasma, waterjet, knife plotters) "
-                                       "or astm (DXF, ASTM D6673 for garment CAD), svg, json (the report); "
+                                       "or astm (DXF, ASTM D6673 for garment CAD), svg, json (the report), bends (a blank's "
+                                       "bend sheet, CSV); "
                                        "default from the file's suffix (.dxf: machine); see docs/dxf.md",
                                  check=_profile, optional=True, metavar="NAME")
     units: str = option("mm", "unit of the drawing (machine profile; ASTM, SVG and JSON are mm); also, on the "

@@ -18,7 +18,7 @@ from ..errors import ExportError, InputError
 from ..files import output_target
 from ..nesting import Layout
 from ..pieces import Drawing, PieceOptions, drawing_of
-from . import astm, machine, report, svg
+from . import astm, bendsheet, machine, report, svg
 from .options import WriteOptions
 from .registry import Profile, profile_for, register
 
@@ -31,6 +31,8 @@ register(Profile("svg", ".svg", svg.write, "SVG at 1:1 in mm for laser and vinyl
                  "black engrave", default=True))
 register(Profile("json", ".json", report.write, "the JSON report: the check, and every piece as drawn",
                  default=True))
+register(Profile("bends", ".csv", bendsheet.write, "the bend sheet (CSV) for the press brake: a row per bend of "
+                 "every blank, in the order to bend them", default=True))
 
 
 def _split(options, keywords) -> tuple:
@@ -52,7 +54,8 @@ def write(source, path, options: WriteOptions | None = None, *, pieces: PieceOpt
     source : patterns.Pattern, patterns.Blank, patterns.Layout, patterns.pieces.Drawing, Piece, or a list of
         patterns, blanks and pieces
     path : str or Path
-        ``.dxf`` (the ``machine`` profile, or ``profile="astm"``), ``.svg`` or ``.json`` (the report).
+        ``.dxf`` (the ``machine`` profile, or ``profile="astm"``), ``.svg``, ``.json`` (the report) or ``.csv``
+        (a blank's bend sheet, the ``bends`` profile).
     options : WriteOptions, optional
         The writer's options; keywords (``profile``, ``units``, ``version``, ``layer_map``,
         ``bend_lines``) go over it.

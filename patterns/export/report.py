@@ -4,7 +4,7 @@ One document per drawing (schema :data:`REPORT_SCHEMA`): the check report of
 what the pieces were made from (``patterns.Report.to_dict``: verdict, limits,
 panels, seams, blanks, findings) and, under ``pieces``, each piece as the DXF
 and SVG of the same drawing draw it -- outline and holes as ``[x, y, bulge]``
-rows, sew lines, notches, drill holes, grain, bend lines with direction,
+rows, the rims of countersunk holes, sew lines, notches, drill holes, grain, bend lines with direction,
 angle, inside radius and K-factor, seam sides, the labels as the DXF places
 them (in mm), strain, findings -- every coordinate in mm in the DXF's frame
 (the drawing's first quadrant).
@@ -18,6 +18,7 @@ import numpy as np
 
 from ..files import atomic_output
 from ..pieces import MARGIN, Drawing, Piece, piece_labels
+from .bendsheet import SequencedBend, sequenced
 from .options import WriteOptions
 
 __all__ = ["REPORT_SCHEMA", "piece_dict", "write"]
@@ -35,6 +36,7 @@ def _xy(points) -> list:
 
 def piece_dict(piece: Piece) -> dict:
     """One piece as the JSON report gives it (mm, the drawing's frame)."""
+    piece = sequenced(piece)  # a blank's bends numbered in the bending sequence, as the DXF labels them
     m = piece.placement
     return {
         "name": piece.name,
@@ -45,12 +47,13 @@ def piece_dict(piece: Piece) -> dict:
         "area_mm2": round(piece.area, 3),
         "outline": _xy(piece.outline.vertices()),
         "holes": [_xy(h.vertices()) for h in piece.holes],
+        "rims": [r.to_dict() for r in piece.rims],
         "sew": [_xy(s) for s in piece.sew] if piece.allowance else [],
         "notches": [{"at": _xy(n.at), "tip": _xy(n.tip), "mouth": None if n.mouth is None else _xy(n.mouth)}
                     for n in piece.notches],
         "drills": _xy(piece.drills),
         "grain": None if piece.grain is None else _xy(piece.grain),
-        "bends": [{"line": _xy(b.line), "angle_deg": round(b.angle, 4), "direction": b.direction,
+        "bends": [{"line": _xy(b.line), "sequence": b.sequence if isinstance(b, SequencedBend) else None, "angle_deg": round(b.angle, 4), "direction": b.direction,
                    "inside_radius_mm": b.inside_radius, "k_factor": b.k_factor,
                    "allowance_mm": None if b.allowance is None else round(b.allowance, 4)} for b in piece.bends],
         "seams": [{"seam": s.seam, "side": s.side, "length_3d_mm": s.length_3d, "length_flat_mm": s.length_flat}

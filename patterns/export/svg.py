@@ -7,8 +7,10 @@ software and services read, by operation:
 
 * **cut** -- red ``#FF0000``: every outline and hole, one closed path each,
   arcs as true SVG arcs (LightBurn layer 02, a Glowforge "cut" step);
-* **score** -- blue ``#0000FF``: sew lines, notches, grain, drill marks and
-  bend lines (dashed) (LightBurn layer 01, a Glowforge "score" step);
+* **score** -- blue ``#0000FF``: sew lines, notches, grain, drill marks,
+  bend lines (dashed) and the rims of countersunk and counterbored holes (a
+  mark where the machinist countersinks; the hole itself is cut at its through
+  diameter) (LightBurn layer 01, a Glowforge "score" step);
 * **engrave** -- black ``#000000`` filled text: names, strains, seam lengths,
   bend labels (LightBurn layer 00, a Glowforge "engrave" step).
 
@@ -28,6 +30,7 @@ from ..files import atomic_output
 from ..pieces import MARGIN, Drawing, piece_labels
 from ..pieces.allowance import straight_runs
 from ..units import Unit
+from .bendsheet import sequenced
 from .options import WriteOptions
 
 __all__ = ["COLOURS", "write"]
@@ -99,6 +102,7 @@ def write(drawing: Drawing, path, options: WriteOptions) -> None:
         for notch in piece.notches:
             ends = [(notch.at, notch.tip)] if notch.mouth is None else [(notch.tip, e) for e in notch.mouth]
             score += [f'<path d="{page.polyline([a, b], False)}"/>' for a, b in ends]
+        score += [f'<path d="{page.loop(Loop((rim.circle,)))}"/>' for rim in piece.rims]  # marked, never cut
         for tip in piece.drills:  # a drill mark: a small cross
             d = 0.5 * piece.text_height
             score += [f'<path d="{page.polyline([tip - [d, 0], tip + [d, 0]], False)}"/>',
@@ -107,7 +111,7 @@ def write(drawing: Drawing, path, options: WriteOptions) -> None:
             score.append(f'<path d="{page.polyline(piece.grain, False)}"/>')
         if options.bend_lines:
             score += [f'<path d="{page.polyline(b.line, False)}" stroke-dasharray="3 2"/>' for b in piece.bends]
-        for label in piece_labels(piece, Unit.MM):
+        for label in piece_labels(sequenced(piece), Unit.MM):  # a blank's bends numbered in sequence
             if label.kind == "bend" and not options.bend_lines:
                 continue
             x, y = label.at[0], height - label.at[1]

@@ -1,7 +1,8 @@
 """Patterns and blanks into pieces: :func:`pieces_of`, the one door into the piece model.
 
 A pattern gives one piece per panel (:func:`~patterns.pieces.panel.panel_piece`);
-a blank gives one piece: its exact outline and holes, its bend lines with
+a blank gives one piece: its exact outline and holes (and the rims of its
+countersunk holes, to mark), its bend lines with
 their direction, angle, inside radius and K-factor, and its findings.  A list
 of patterns, blanks and pieces gives all their pieces, named
 ``"<part>/<piece>"`` when more than one part is in it.  Each piece made here
@@ -48,7 +49,7 @@ def blank_piece(blank: Blank, options: PieceOptions | None = None) -> Piece:
                     for b in blank.bends),
         seams=(), title=(f"T {blank.thickness:g} MM  {how}  {w:.1f} x {h:.1f} MM",),
         text_height=text_height_for(max(w, h), options.text_height), label_at=label_at,
-        source=Source("blank", blank.name, 0, tuple(faces)), strain=None, findings=blank.findings)
+        source=Source("blank", blank.name, 0, tuple(faces)), strain=None, findings=blank.findings, rims=blank.rims)
 
 
 def _pattern_pieces(pattern: Pattern, options: PieceOptions, findings) -> list:

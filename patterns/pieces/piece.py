@@ -231,6 +231,9 @@ class Piece:
         Its triangles and strains, when asked for (``strain_layer``).
     placement : patterns.curves.Motion
         How the piece was moved from where its panel or blank lies (laid out, nested, mirrored).
+    rims : tuple of patterns.blank.Rim
+        A blank's countersinks' and counterbores' rims: circles marked, not cut (the hole is cut at its
+        through diameter, one of ``holes``).
     """
 
     name: str
@@ -251,6 +254,7 @@ class Piece:
     findings: tuple = ()
     strain_map: StrainMap | None = None
     placement: Motion = field(default_factory=Motion)
+    rims: tuple = ()
 
     def __post_init__(self):
         object.__setattr__(self, "sew", tuple(_frozen(s, (-1, 2)) for s in self.sew))
@@ -291,7 +295,7 @@ class Piece:
             seams=tuple(s.moved(motion) for s in self.seams), label_at=motion(self.label_at),
             findings=tuple(f.moved(motion) for f in self.findings),
             strain_map=None if self.strain_map is None else self.strain_map.moved(motion),
-            placement=motion @ self.placement)
+            placement=motion @ self.placement, rims=tuple(r.moved(motion) for r in self.rims))
 
     def copy(self, name: str, number: int, *, mirrored: bool = False) -> Piece:
         """Another piece of the same, named ``name`` (its ``number``-th copy); ``mirrored``: its mirror image

@@ -23,6 +23,8 @@ The result is a :class:`patterns.Blank`, whose findings are the same
 
 from __future__ import annotations
 
+from dataclasses import replace
+from functools import partial
 from pathlib import Path
 
 from ..blank import Bend, Blank
@@ -32,10 +34,13 @@ from ..reading import CAD_SUFFIXES, check_source, read_cad
 from ..tessellate.topology import read_topology
 from ..text import counted
 from .bends import curvatures, face_maps, group_bends
-from .contour import bend_line, cut_loops, overlaps
+from .contour import bend_line, clip_to, contour_faults, cut_loops, overlaps
 from .faces import recognise, uv_mid
+from .holes import hole_rims
+from .imported import prepared
 from .join import flat, place_faces
 from .meshed import mesh_face
+from .rules import manufacturability, open_contours
 from .sheet import check_volume, find_sheet
 from .table import BendTable, UnfoldOptions, read_bend_table
 
@@ -62,7 +67,8 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
         The folded solid (STEP, BREP or IGES file, mm).
     options : UnfoldOptions, optional
         The options as a record; keywords (``k_factor``, default 0.5;
-        ``bend_table``, a CSV path or :class:`BendTable`; ``fixed_face``) go over it.
+        ``bend_table``, a CSV path or :class:`BendTable`; ``material``, its K-factors from a material table;
+        ``fixed_face``) go over it.
     name : str, optional
         For messages and the report (default: the file's stem).
 
@@ -83,25 +89,36 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
     """
     shape, name = _shape(shape_or_path, name)
     opts = UnfoldOptions.of(options, keywords, name=name)
+    shape = prepared(shape, name)  # one solid; B-spline faces that are planes, cylinders or cones made so
     topology = read_topology(shape, name=name)
     faces = recognise(topology)
     sheet = find_sheet(topology, faces, opts.fixed_face, name)
     curvature = curvatures(faces, sheet, name)
-    meshed = {i: mesh_face(faces[i], sheet.thickness, opts.k_factor, name)  # the K-factor even with a bend table
+    meshed = {i: mesh_face(faces[i], sheet.thickness, opts.k_factor if opts.material is None else  # K even with a
+                           partial(opts.k_factor_at, sheet.thickness, what=f"{name}: face {i}"), name)  # bend table
               for i in sorted(sheet.skin) if faces[i].kind == "other"}
     check_volume(shape, sheet, faces, {i: (c.bend_radius, c.inside_radius) for i, c in curvature.items()}, meshed,
                  name)
     bends = group_bends(faces, sheet, curvature, opts, name)
     maps = face_maps(faces, sheet, curvature, bends, meshed, opts.k_factor)
     motions, gaps = place_faces(topology, maps, sheet, name)
-    loops = cut_loops(topology, maps, motions, sheet.skin, name)
-    outline = max(loops, key=lambda lp: lp.area)
-    holes = tuple(lp for lp in loops if lp is not outline)
-    k_factor = None if opts.bend_table is not None else opts.k_factor
-    drawn = tuple(Bend(line=bend_line(maps, motions, b), angle=b.angle, inside_radius=b.inside_radius,
-                       direction=b.direction, allowance=b.allowance, faces=b.faces, k_factor=k_factor)
-                  for b in bends)
+    lines = [bend_line(maps, motions, b) for b in bends]
+    zones = {i: (line, b.allowance / 2) for b, line in zip(bends, lines) for i in b.faces}
+    loops, open_ends = cut_loops(topology, maps, motions, sheet.skin, name, relief=opts.corner_relief,
+                                 thickness=sheet.thickness, bend_lines=zones)
+    outline = max(loops, key=lambda lp: lp[0].area)[0]
+    holes = tuple(lp for lp, _ in loops if lp is not outline)
+    holes, rims = hole_rims(topology, faces, maps, motions, sheet, holes)  # countersinks: cut at the through hole
+    lines = [clip_to(line, outline) for line in lines]  # a bend line ends where a corner relief cuts its zone
+    ks = {b.k_factor for b in bends}  # a material's: the one K-factor of every bend, or None
+    k_factor = None if opts.bend_table is not None else opts.k_factor if opts.material is None else \
+        (ks.pop() if len(ks) == 1 else None)
+    drawn = tuple(Bend(line=line, angle=b.angle, inside_radius=b.inside_radius,
+                       direction=b.direction, allowance=b.allowance, faces=b.faces, k_factor=b.k_factor)
+                  for b, line in zip(bends, lines))
     findings = list(overlaps(topology, maps, motions, sheet.skin, gaps, name))
+    findings += open_contours(open_ends, name)
+    findings += contour_faults(loops, sheet.thickness, name, overlapping=bool(findings))
     findings += [Finding(Code.BEND_WITHOUT_FLANGE, Severity.NOTE, (name,), bend.line.mean(axis=0)[None, :], (), None,
                          f"{name}: bend at faces {', '.join(map(str, bend.faces))} has no flat face on one side")
                  for bend, group in zip(drawn, bends) if not group.flanged]
@@ -114,5 +131,7 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
             f"{d.strain_rms:.3%}); its edges land within {gaps[i]:.3f} mm of the faces beside it"))
     order = {Severity.ERROR: 0, Severity.LIMIT: 1, Severity.NOTE: 2}
     findings.sort(key=lambda f: order[f.severity])
-    return Blank(name=name, outline=outline, holes=holes, bends=drawn, thickness=sheet.thickness,
-                 k_factor=k_factor, fixed_face=sheet.fixed, findings=tuple(findings))
+    blank = Blank(name=name, outline=outline, holes=holes, bends=drawn, thickness=sheet.thickness,
+                  k_factor=k_factor, fixed_face=sheet.fixed, findings=tuple(findings), material=opts.material,
+                  rims=rims)
+    return replace(blank, findings=blank.findings + manufacturability(blank))  # a shop's notes, after the rest

@@ -80,6 +80,9 @@ class BendGroup:
         ``"up"`` or ``"down"``.
     flanged : bool
         A flat face on both sides.
+    k_factor : float or None
+        The K-factor it was developed with (``k_factor``, or the material table's for its inside radius); None
+        when a bend table gave its allowance.
     """
 
     faces: tuple
@@ -90,6 +93,7 @@ class BendGroup:
     neutral_radius: float
     direction: str
     flanged: bool
+    k_factor: float | None = None
 
 
 def _same_bend(fa: SheetFace, fb: SheetFace) -> bool:
@@ -122,9 +126,11 @@ def group_bends(faces: tuple, sheet: Sheet, curvature: dict, opts: UnfoldOptions
         bend = curvature[group[0]]
         sides = sum(1 for i in group for j, _ in sheet.neighbours[i] if faces[j].kind == "plane")
         direction = "up" if bend.concave else "down"
+        k = opts.k_factor_at(sheet.thickness, bend.inside_radius,  # the material's K for its r/t, else k_factor
+                             what=f"{name}: the bend at faces {', '.join(map(str, group))}")
         if first.kind == "cone":
-            angle, allowance = _cone_bend(faces, group, curvature, sheet, opts, name)
-            out.append(BendGroup(group, "cone", angle, bend.inside_radius, allowance, 0.0, direction, sides >= 2))
+            angle, allowance = _cone_bend(faces, group, curvature, sheet, opts, k, name)
+            out.append(BendGroup(group, "cone", angle, bend.inside_radius, allowance, 0.0, direction, sides >= 2, k))
             continue
         spans = []
         for i in group:
@@ -133,24 +139,24 @@ def group_bends(faces: tuple, sheet: Sheet, curvature: dict, opts: UnfoldOptions
         angle = float(np.degrees(max(spans)))
         r_in = bend.inside_radius
         if opts.bend_table is not None:
-            allowance = opts.bend_table.allowance(sheet.thickness, r_in, angle)
+            allowance, k = opts.bend_table.allowance(sheet.thickness, r_in, angle), None
         else:
-            allowance = np.radians(angle) * (r_in + opts.k_factor * sheet.thickness)
+            allowance = np.radians(angle) * (r_in + k * sheet.thickness)
         out.append(BendGroup(group, "cylinder", angle, r_in, float(allowance), float(allowance / np.radians(angle)),
-                             direction, sides >= 2))
+                             direction, sides >= 2, k))
     return tuple(out)
 
 
-def _cone_bend(faces, group, curvature, sheet, opts, name) -> tuple:
+def _cone_bend(faces, group, curvature, sheet, opts, k_factor, name) -> tuple:
     """A conical bend's angle (the turn of its normal across its middle) and developed width (across its
-    middle, on its neutral cone)."""
+    middle, on its neutral cone, ``k_factor`` t from the inside skin)."""
     from OCP.BRepTools import BRepTools
 
     if opts.bend_table is not None:
         raise InputError(f"{name}: faces {', '.join(map(str, group))} are a conical bend; a bend table gives "
                          f"cylindrical bends only (use the K-factor)")
     first = faces[group[0]]
-    fmap = _cone_map(first, curvature[group[0]], sheet.thickness, opts.k_factor)
+    fmap = _cone_map(first, curvature[group[0]], sheet.thickness, k_factor)
     u0, u1, v0, v1 = BRepTools.UVBounds_s(first.face)
     vm = 0.5 * (v0 + v1)
     angle = float(np.degrees(np.arccos(np.clip(normal(first, u0, vm) @ normal(first, u1, vm), -1.0, 1.0))))
@@ -213,15 +219,16 @@ def _cone_map(f: SheetFace, bend: Curvature, thickness: float, k_factor: float) 
 
 
 def face_maps(faces: tuple, sheet: Sheet, curvature: dict, bends: tuple, meshed: dict, k_factor: float) -> dict:
-    """``{face: FaceMap}`` of every skin face."""
+    """``{face: FaceMap}`` of every skin face (a cone's neutral surface at its bend's K-factor, else ``k_factor``)."""
     neutral = {i: b.neutral_radius for b in bends if b.kind == "cylinder" for i in b.faces}
+    k_of = {i: b.k_factor for b in bends if b.k_factor is not None for i in b.faces}
     out = {}
     for i in sorted(sheet.skin):
         f = faces[i]
         if f.kind == "other":
             out[i] = FaceMap(f, meshed=meshed[i])
         elif f.kind == "cone":
-            out[i] = _cone_map(f, curvature[i], sheet.thickness, k_factor)
+            out[i] = _cone_map(f, curvature[i], sheet.thickness, k_of.get(i, k_factor))
         else:
             u, v = uv_mid(f.face)
             across = neutral[i] if f.kind == "cylinder" else 1.0

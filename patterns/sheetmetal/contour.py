@@ -14,13 +14,19 @@ import numpy as np
 import shapely
 
 from ..curves import Arc, Line, Loop, Polyline
-from ..errors import FlattenError
 from ..findings import Code, Finding, Severity
 from ..tessellate.topology import Topology
 from .bends import BendGroup
+from .corners import is_bend_end, treat_corners
 from .join import flat
 
-__all__ = ["bend_line", "cut_loops", "overlaps"]
+__all__ = ["CUSP_DEGREES", "bend_line", "clip_to", "contour_faults", "cut_loops", "overlaps"]
+
+CUSP_DEGREES = 30.0
+"""A corner of the cut contour sharper than this (degrees) is a cusp: a spike of material a laser burns, or a
+notch narrower than its kerf (the model's corner developed as it is makes notches of 19-27 degrees)."""
+SLIVER = 0.5
+"""Material narrower than this many thicknesses is a sliver."""
 
 SAMPLE = 0.001
 """Chord error of curved pieces sampled as polylines, mm."""
@@ -69,8 +75,20 @@ def _piece(edge, face: int, maps: dict, motions: dict, flip: bool):
     return Polyline(at(ts))
 
 
-def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, name: str) -> list:
-    """The cut contour: skin edges that meet a rim, chained into closed loops by their vertices."""
+def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, name: str, *, relief: str = "none",
+              thickness: float = 0.0, bend_lines: dict | None = None) -> tuple:
+    """The cut contour: skin edges that meet a rim, chained into closed loops by their vertices, with the
+    corners where bends meet treated as ``relief`` says (:func:`~patterns.sheetmetal.corners.treat_corners`).
+
+    Returns
+    -------
+    loops : list of (Loop, tuple of int)
+        Each loop and the skin face each of its pieces comes from.
+    gaps : list of (2, 2) float64, mm
+        Where a contour that does not close stops and where it should go on (the loop is closed across
+        it by a line, so that the blank can be drawn for the finding; :func:`~patterns.sheetmetal.rules.
+        open_contours` makes the errors).
+    """
     from OCP.TopAbs import TopAbs_REVERSED
 
     by_start = {}
@@ -81,16 +99,22 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
                     continue
                 flip = edge.Orientation() == TopAbs_REVERSED
                 a, b = topology.edge_vertices[e][::-1] if flip else topology.edge_vertices[e]
-                by_start.setdefault(a, []).append((b, _piece(edge, i, maps, motions, flip)))
-    loops = []
+                piece = _piece(edge, i, maps, motions, flip)
+                by_start.setdefault(a, []).append((b, (piece, i, is_bend_end(piece, maps[i].kind))))
+    loops, gaps = [], []
+    ends = {b for chain in by_start.values() for b, _ in chain}
     while by_start:
-        first = next(iter(by_start))
-        pieces, at = [], first
+        first = next((v for v in by_start if v not in ends), next(iter(by_start)))  # an open chain from its start
+        pieces, at, closed = [], first, True
         while True:
             nxt = by_start.get(at)
-            if not nxt:
-                raise FlattenError(f"{name}: the cut contour does not close at a vertex of the model "
-                                   f"(after {len(pieces)} edges)")
+            if not nxt:  # open: closed by a line across the gap for the drawing, and said (an open-contour error)
+                closed = False
+                start, stop = pieces[0][0].points()[0], pieces[-1][0].points()[-1]
+                if np.linalg.norm(start - stop) > 1e-6:
+                    gaps.append(np.array([stop, start]))
+                    pieces.append((Line(stop, start), pieces[-1][1], False))
+                break
             to, piece = nxt.pop()
             if not nxt:
                 del by_start[at]
@@ -98,8 +122,10 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
             at = to
             if at == first:
                 break
-        loops.append(Loop(tuple(pieces)))
-    return loops
+        treated = (treat_corners(pieces, relief=relief, thickness=thickness, bend_lines=bend_lines or {}) if closed
+                   else [(p, f) for p, f, _ in pieces])  # an open loop is drawn as it is found
+        loops.append((Loop(tuple(p for p, _ in treated)), tuple(f for _, f in treated)))
+    return loops, gaps
 
 
 def bend_line(maps: dict, motions: dict, bend: BendGroup) -> np.ndarray:
@@ -116,6 +142,21 @@ def bend_line(maps: dict, motions: dict, bend: BendGroup) -> np.ndarray:
     d /= np.linalg.norm(d)
     s = (ends - ends[0]) @ d
     return np.array([ends[np.argmin(s)], ends[np.argmax(s)]])
+
+
+def clip_to(line: np.ndarray, outline: Loop) -> np.ndarray:
+    """(2, 2) float64, mm: a bend line cut back to the part of it inside the outline (first to last point inside),
+    so that it stops at a corner relief; the line as it is when it lies wholly inside (or, oddly, wholly outside)."""
+    polygon = outline.polygon
+    if not polygon.is_valid:  # a contour crossing itself is a finding of its own; the line stays as it is
+        return line
+    inside = shapely.LineString(line).intersection(polygon)
+    if inside.is_empty or inside.length >= np.linalg.norm(line[1] - line[0]) - 1e-9:
+        return line
+    d = line[1] - line[0]
+    s = np.concatenate([np.asarray(g.coords) for g in getattr(inside, "geoms", [inside]) if g.length > 0]) - line[0]
+    t = s @ d / (d @ d)
+    return np.array([line[0] + t.min() * d, line[0] + t.max() * d])
 
 
 def overlaps(topology: Topology, maps: dict, motions: dict, skin: frozenset, gaps: dict, name: str):
@@ -146,3 +187,58 @@ def overlaps(topology: Topology, maps: dict, motions: dict, skin: frozenset, gap
             yield Finding(Code.FLANGES_OVERLAP, Severity.ERROR, (name,), point[None, :], (), None,
                           f"{name}: faces {keys[a]} and {keys[b]} overlap by {common.area:.2f} mm² once "
                           f"unfolded: the blank cannot be cut in one piece")
+
+
+def contour_faults(loops: list, thickness: float, name: str, *, overlapping: bool = False) -> list:
+    """``outline-cusp``, ``outline-touches-itself`` and ``sliver`` findings on a blank's cut loops.
+
+    Parameters
+    ----------
+    loops : list of (Loop, tuple of int)
+        The cut loops (the largest the outline) and the skin face each of their pieces comes from.
+    thickness : float
+        The sheet's thickness, mm (a sliver is narrower than :data:`SLIVER` of it).
+    name : str
+        The part, for messages.
+    overlapping : bool
+        Flanges already found to land on one another: their contours cross, and that is said once, there.
+    """
+    out = []
+    outline = max(loops, key=lambda lp: lp[0].area)[0]
+    for loop, faces in loops:
+        sign = 1.0 if (loop is outline) == loop.counter_clockwise else -1.0  # material on the left when > 0
+        for k, (piece, face) in enumerate(zip(loop.pieces, faces)):
+            pts = piece.points(0.01)
+            nxt = loop.pieces[(k + 1) % len(loop.pieces)].points(0.01)
+            run = np.vstack([pts, nxt[1:2]])  # the piece's own corners and the one where it meets the next
+            a, b = run[1:-1] - run[:-2], run[2:] - run[1:-1]
+            keep = (np.linalg.norm(a, axis=1) > 1e-9) & (np.linalg.norm(b, axis=1) > 1e-9)
+            a, b, at = a[keep], b[keep], run[1:-1][keep]
+            turn = np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))) * sign
+            sharp = np.abs(turn) > 180.0 - CUSP_DEGREES  # the contour turns back on itself
+            if sharp.any():
+                k = int(np.argmax(np.abs(turn)))
+                what = "a spike of material" if turn[k] > 0 else "a notch narrower than a kerf at its tip"
+                out.append(Finding(Code.OUTLINE_CUSP, Severity.NOTE, (name,), at[k][None, :], (), None,
+                                   f"{name}: the cut contour comes to a point of {180 - abs(turn[k]):.1f} degrees at "
+                                   f"x {at[k][0]:.3f}, y {at[k][1]:.3f} mm (face {face}): {what}"))
+    polygon = shapely.Polygon(outline.points(0.01), [lp.points(0.01) for lp, _ in loops if lp is not outline])
+    if not polygon.is_valid:
+        if overlapping:
+            return out
+        where = shapely.get_coordinates(shapely.make_valid(polygon).boundary)[:1]
+        out.append(Finding(Code.OUTLINE_TOUCHES_ITSELF, Severity.ERROR, (name,), where, (), None,
+                           f"{name}: the cut contours touch or cross ({shapely.is_valid_reason(polygon)}): the blank "
+                           f"cannot be cut in one piece"))
+        return out
+    width = SLIVER * thickness
+    opened = polygon.buffer(-width / 2, join_style="mitre", mitre_limit=10.0).buffer(
+        width / 2, join_style="mitre", mitre_limit=10.0)
+    thin = polygon.difference(opened.buffer(1e-6, join_style="mitre"))
+    for part in getattr(thin, "geoms", [thin]):
+        if part.area > 0.05 * width * width and part.length > 4 * width:
+            at = np.array(part.representative_point().coords)
+            out.append(Finding(Code.SLIVER, Severity.NOTE, (name,), at, (), None,
+                               f"{name}: a strip narrower than {width:.2f} mm (half the thickness) at x "
+                               f"{at[0][0]:.3f}, y {at[0][1]:.3f} mm, {part.area:.2f} mm²"))
+    return out

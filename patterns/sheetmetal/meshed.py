@@ -11,6 +11,7 @@ strain (``meshed-face``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -73,8 +74,25 @@ class MeshedFace:
         return np.einsum("pj,pjd->pd", bary[rows, near], self.uv[tris[cand[rows, near]]])
 
 
-def mesh_face(f: SheetFace, thickness: float, k_factor: float, name: str) -> MeshedFace:
-    """Mesh and flatten a face that is not developable as a plane, cylinder or cone."""
+def inside_radius(f: SheetFace, thickness: float, concave: bool) -> float:
+    """A face's inside bend radius at its middle, mm: its tightest radius of curvature there, less the
+    thickness when the skin is on the outside of the bend (0 where it is flat)."""
+    from OCP.BRepLProp import BRepLProp_SLProps
+
+    u, v = uv_mid(f.face)
+    props = BRepLProp_SLProps(f.adaptor, u, v, 2, 1e-9)
+    curvature = max(abs(props.MaxCurvature()), abs(props.MinCurvature())) if props.IsCurvatureDefined() else 0.0
+    if curvature <= 1e-12:
+        return float("inf")
+    return max(1.0 / curvature - (0.0 if concave else thickness), 0.0)
+
+
+def mesh_face(f: SheetFace, thickness: float, k_factor: float | Callable, name: str) -> MeshedFace:
+    """Mesh and flatten a face that is not developable as a plane, cylinder or cone.
+
+    ``k_factor``: the K-factor, or ``k_factor(inside radius mm) -> K`` (a material's), asked at the face's
+    middle (:func:`inside_radius`).
+    """
     import trimesh
 
     # well-shaped triangles, half the thickness across (fewer, larger on a large face: about 2000)
@@ -84,7 +102,8 @@ def mesh_face(f: SheetFace, thickness: float, k_factor: float, name: str) -> Mes
     normals = np.asarray(trimesh.Trimesh(vertices, tris, process=False).vertex_normals)
     u, v = uv_mid(f.face)
     concave = float(np.mean((vertices - point(f, u, v)) @ normal(f, u, v))) > 0  # curving towards its normal
-    into = k_factor * thickness if concave else (1 - k_factor) * thickness  # the neutral surface, into the sheet
+    k = k_factor(inside_radius(f, thickness, concave)) if callable(k_factor) else k_factor
+    into = k * thickness if concave else (1 - k) * thickness  # the neutral surface, into the sheet
     result = flatten_mesh(vertices - into * normals, tris, name=f"{name} face {f.index}")
     uv = np.array(result.uv)
     if signed_areas(uv, tris).sum() < 0:

@@ -184,6 +184,22 @@ def check_volume(shape, sheet: Sheet, faces, curvature: dict, meshed: dict, name
             bend_radius, r_in = curvature[i]
             expected += f.area / bend_radius * ((r_in + t) ** 2 - r_in ** 2) / 2
     if abs(volume - expected) > 0.01 * volume:
+        formed = _doubly_curved(faces)
+        if formed:
+            raise InputError(f"{name}: faces {', '.join(str(i) for i, _ in formed[:6])}"
+                             f"{' ...' if len(formed) > 6 else ''} are doubly curved "
+                             f"({', '.join(sorted({k for _, k in formed}))}): a formed or drawn shell has no "
+                             f"flat blank to unfold (patterns flatten makes its pattern, with the strain)")
         raise InputError(f"{name}: not a sheet of constant thickness: the solid holds {volume:.0f} mm³, a "
                          f"{t:g} mm sheet over its skin {expected:.0f} mm³ (a machined block or a "
                          f"part of several thicknesses)")
+
+
+def _doubly_curved(faces) -> list:
+    """``[(face, "sphere" | "torus")]``: the faces no press brake or roll can make (a formed or drawn shell)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.GeomAbs import GeomAbs_Sphere, GeomAbs_Torus
+
+    kinds = {GeomAbs_Sphere: "sphere", GeomAbs_Torus: "torus"}
+    found = [(i, kinds.get(BRepAdaptor_Surface(f.face).GetType())) for i, f in enumerate(faces)]
+    return [(i, k) for i, k in found if k is not None]

@@ -3,7 +3,8 @@
 :class:`UnfoldOptions` is the one declaration of every unfold option for the
 API, the command line and batches; :func:`read_bend_table` reads a CSV of
 bend deductions that then gives every cylindrical bend's developed width
-instead of the K-factor.
+instead of the K-factor; ``material`` takes each bend's K-factor from a
+material table (:mod:`~patterns.sheetmetal.materials`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,9 @@ import numpy as np
 
 from ..errors import InputError
 from ..files import check_input_file
-from ..options import Options, option
+from ..options import Options, label, option
+from .corners import CORNER_RELIEFS
+from .materials import MaterialTable, _path_or_table, bundled_materials
 
 __all__ = ["BendTable", "UnfoldOptions", "read_bend_table"]
 
@@ -132,6 +135,16 @@ def _check_row(path, line, thickness, radius, angle, deduction) -> None:
                          f"{deduction_range(thickness, radius, angle, slack=0)[1]:.3f} mm)")
 
 
+def _material(value, option) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise InputError(f"{option} must be a material's name, got {value!r}")
+    return value.strip().lower()
+
+
+K_DEFAULT = 0.5
+"""The K-factor when none is given (the neutral layer in the middle of the sheet)."""
+
+
 def _table(value, option):
     if isinstance(value, BendTable):
         return value
@@ -144,7 +157,7 @@ def _table(value, option):
 class UnfoldOptions(Options):
     """How a bent sheet-metal part is unfolded (:func:`unfold`, ``patterns unfold``)."""
 
-    k_factor: float = option(0.5, "position of the neutral layer in the bends from the inside, as a fraction of "
+    k_factor: float = option(K_DEFAULT, "position of the neutral layer in the bends from the inside, as a fraction of "
                                   "the thickness (SolidWorks' and FreeCAD's K-factor)", low=0, high=1)
     bend_table: BendTable | None = option(None, "bend-deduction table, CSV with columns thickness, radius, angle, "
                                       "deduction (mm, degrees); it gives every bend instead of the K-factor",
@@ -152,3 +165,42 @@ class UnfoldOptions(Options):
     fixed_face: int | None = option(None, "the CAD face that keeps its place (shape.faces() index; default the "
                                           "largest planar face that starts a sheet)", integer=True, low=0, optional=True,
                                     metavar="N")
+    corner_relief: str = option("none", "where two bends meet at a corner: none (the flanges' edges run on until "
+                                        "they meet, as SolidWorks draws a closed corner), rectangular (the square "
+                                        "where the bend zones cross cut out), round (a circle about the bend lines' "
+                                        "crossing, clear of both zones), tear (a rip to the inside corner) or "
+                                        "as-modelled (the model's corner faces developed as they are)",
+                                choices=CORNER_RELIEFS)
+    material: str | None = option(None, "the sheet's material: each bend's K-factor from the material table, by "
+                                        "the thickness and the bend's inside radius over it (r/t); the bundled table "
+                                        "has " + ", ".join(bundled_materials().names) + " (see docs/sheet-metal.md)",
+                                  optional=True, check=_material, metavar="NAME")
+    material_table: MaterialTable | None = option(None, "your own material table for material, CSV with columns "  # noqa: RUF009
+                                                        "material, thickness_min, thickness_max, rt_min, rt_max, "
+                                                        "k_factor (default: the bundled table)",
+                                                  optional=True, check=_path_or_table, metavar="CSV")
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.material is None:
+            if self.material_table is not None:
+                raise InputError(f"{label('material_table')} gives K-factors by material: name the material "
+                                 f"({label('material')} NAME)")
+            return
+        given = [label(n) for n, on in (("bend_table", self.bend_table is not None),
+                                        ("k_factor", self.k_factor != K_DEFAULT)) if on]
+        if given:
+            raise InputError(f"{label('material')} gives every bend its K-factor, {given[0]} gives them too: "
+                             f"give one of {label('material')}, {label('k_factor')} and {label('bend_table')}")
+        table = self.material_table or bundled_materials()
+        if self.material not in table.names:
+            raise InputError(f"unknown {label('material')} {self.material!r}; {table.where} has "
+                             f"{', '.join(table.names)}")
+
+    def k_factor_at(self, thickness: float, inside_radius: float, *, what: str = "a bend") -> float:
+        """A bend's K-factor: the material table's for its thickness and inside radius (mm) when ``material``
+        is given (InputError when no row covers it, naming ``what``), else ``k_factor``."""
+        if self.material is None:
+            return self.k_factor
+        return (self.material_table or bundled_materials()).k_factor(self.material, thickness, inside_radius,
+                                                                      what=what)
