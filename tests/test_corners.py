@@ -159,3 +159,19 @@ def test_contours_that_touch_are_an_error():
     (touch,) = [f for f in found if f.code is patterns.Code.OUTLINE_TOUCHES_ITSELF]
     assert touch.error and touch.message.startswith("bow: the cut contours touch or cross")
     assert not contour_faults([(square, (0,) * 4)], 1.0, "square")
+
+
+def test_of_two_equal_sides_the_one_the_walls_rise_from_is_fixed(tray):
+    """The base's two faces have one area; the inside one is fixed whatever order the file lists them in
+    (from the outside, the 0.1 mm mitres' outside skins overlap: flanges-overlap)."""
+    path, inside = tray
+    blank = patterns.unfold(path, k_factor=K)
+    assert blank.fixed_face == inside and blank.ok
+    assert {b.direction for b in blank.bends} == {"up"}  # the walls rise towards the viewer
+    faces = bd.import_step(str(path)).faces()
+    outside = max((i for i, f in enumerate(faces) if f.geom_type == bd.GeomType.PLANE and abs(f.center().Z) < 1e-6),
+                  key=lambda i: faces[i].area)
+    assert faces[outside].area == pytest.approx(faces[inside].area, rel=1e-9)
+    other = patterns.unfold(path, k_factor=K, fixed_face=outside)
+    overlaps = [f for f in other.findings if f.code is patterns.Code.FLANGES_OVERLAP]
+    assert not other.ok and len(overlaps) == 4  # each corner's two mitred outside skins

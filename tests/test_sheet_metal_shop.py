@@ -363,4 +363,5 @@ def test_report_numbers_the_bends_as_the_dxf_does(z_bracket, tmp_path):
     (piece,) = json.loads((tmp_path / "z.json").read_text())["pieces"]
     assert sorted(b["sequence"] for b in piece["bends"]) == [1, 2]
     labels = sorted(lb["text"] for lb in piece["labels"] if lb["kind"] == "bend")
-    assert labels == ["1 UP 90.0 DEG R3", "2 DOWN 90.0 DEG R3"]
+    # from the face the flanges rise from (of flange C's two equal sides): flange A's bend down, C's up
+    assert labels == ["1 DOWN 90.0 DEG R3", "2 UP 90.0 DEG R3"]

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..errors import InputError
 from ..tessellate.topology import Topology
 from .faces import normal, point, uv_mid
@@ -61,7 +63,8 @@ def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: s
     if largest.kind == "cylinder" and any(owners == (largest.index, largest.index) for owners in topology.edge_faces):
         raise InputError(f"{name}: a closed tube (face {largest.index} goes all the way round, with no seam): "
                          f"cut it along a line of its axis first")
-    planes = sorted((f for f in faces if f.kind == "plane"), key=lambda f: -f.area)
+    planes = sorted((f for f in faces if f.kind == "plane"), key=lambda f: (-round(f.area / largest.area, 9),
+                                                                          -_inwards(f, faces)))
     if not planes:
         raise InputError(f"{name}: not a sheet-metal part: it has no planar face")
     if fixed_face is not None and (fixed_face >= len(faces) or faces[fixed_face].kind != "plane"):
@@ -86,6 +89,17 @@ def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: s
         raise InputError(f"{first}; no other planar face starts a sheet either (fixed_face=N, --fixed-face N, "
                          f"names the face to unfold from)") from None
     raise first
+
+
+def _inwards(f, faces) -> float:
+    """How far the part's surface lies on the outward side of planar face ``f`` (its faces' mid points,
+    weighted by area, mm): the inside of a tray's base faces its walls.  Of two faces of one area (a plate's
+    two sides) the one the flanges rise from is fixed first, whatever order the file lists them in."""
+    u, v = uv_mid(f.face)
+    n, p = normal(f, u, v), point(f, u, v)
+    mids = np.array([point(g, *uv_mid(g.face)) for g in faces])
+    weights = np.array([g.area for g in faces])
+    return float(((mids - p) @ n * weights).sum() / weights.sum())
 
 
 def _thickness(faces, fixed, name) -> float:
