@@ -7,7 +7,7 @@ that side's farthest edge lies from the bend line, measured square to it.  A
 flange bent from the edge of another flange (a return, a hem) is shallower
 than the flange it sits on, so it is bent first, while the part is still flat
 enough to lie on the die; the bends next to the big middle face come last.
-Bends whose outer flanges are equally deep (within :data:`TIE` mm) go
+Bends whose outer flanges are equally deep (counted in steps of :data:`TIE` mm) go
 shortest bend line first (the short sides of a box before its long ones);
 bends equal in both keep the order of the blank's bends.
 
@@ -19,7 +19,6 @@ order: the rule depends on lengths only, never on where the blank lies.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cmp_to_key
 
 import numpy as np
 import shapely
@@ -93,13 +92,10 @@ def sequence(polygon: shapely.Polygon, lines) -> tuple:
     outer = [min(flange_depths(polygon, line)) for line in lines]
     length = [float(np.linalg.norm(np.subtract(*np.asarray(line).reshape(2, 2)))) for line in lines]
 
-    def before(i, j):
-        for x, y in ((outer[i], outer[j]), (length[i], length[j])):
-            if abs(x - y) > TIE:
-                return -1 if x < y else 1
-        return -1 if i < j else (1 if i > j else 0)
-
-    return tuple(sorted(range(len(outer)), key=cmp_to_key(before)))
+    # depths and lengths counted in steps of TIE: a total order (a comparison "within TIE" is not transitive,
+    # and the report and the drawing, measured on differently sampled outlines, could then number a near tie
+    # apart)
+    return tuple(sorted(range(len(outer)), key=lambda i: (round(outer[i] / TIE), round(length[i] / TIE), i)))
 
 
 @dataclass(frozen=True)

@@ -182,3 +182,12 @@ def test_the_rules_never_mutate_the_blank_and_take_their_die():
     (finding,) = manufacturability(blank, die_width=8.0)
     assert f"needs {4 * T - ALLOWANCE / 2:.2f} mm" in finding.message
     assert blank.to_dict() == before
+
+
+def test_a_hole_that_bites_into_a_bend_zone_is_near_it_at_0_mm():
+    """A Ø3 hole drilled 0.5 mm past the base's tangent line cuts into the bend from one side: it is the worst
+    case of a hole near a bend (0 mm), not a relief (which would cross the zone, or run over its end)."""
+    blank = patterns.unfold(tab(hole=((-1.0, WIDTH / 2), 1.5)), k_factor=K)
+    near = [f for f in blank.findings if f.code is patterns.Code.HOLE_NEAR_BEND]
+    assert len(near) == 1 and "inside the bend's zone" in near[0].message
+    assert np.linalg.norm(np.subtract(*near[0].points)) == pytest.approx(0.0, abs=1e-9)

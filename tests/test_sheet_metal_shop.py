@@ -365,3 +365,17 @@ def test_report_numbers_the_bends_as_the_dxf_does(z_bracket, tmp_path):
     labels = sorted(lb["text"] for lb in piece["labels"] if lb["kind"] == "bend")
     # from the face the flanges rise from (of flange C's two equal sides): flange A's bend down, C's up
     assert labels == ["1 DOWN 90.0 DEG R3", "2 UP 90.0 DEG R3"]
+
+
+@pytest.mark.slow
+def test_a_material_unfolds_a_meshed_jog_flat_at_its_middle():
+    """An S-shaped jog drawn as a spline is meshed; its middle is an inflection (flat: r/t infinite), so no
+    material row gives its K: the mid-plane's (0.5) is taken, and the blank is the centre line's length."""
+    path = bd.Wire([bd.Edge.make_line((-40, 0, 0), (0, 0, 0)),
+                    bd.Edge.make_spline([(0, 0, 0), (15, 0, 6), (30, 0, 12)], tangents=[(1, 0, 0), (1, 0, 0)]),
+                    bd.Edge.make_line((30, 0, 12), (70, 0, 12))])
+    plane = bd.Plane(origin=path.position_at(0), x_dir=(0, 1, 0), z_dir=path.tangent_at(0))
+    jog = bd.sweep(plane * bd.Rectangle(40, 2), path=path, transition=bd.Transition.RIGHT)  # centred on the path
+    blank = patterns.unfold(jog, material="mild-steel")
+    assert [f.code for f in blank.findings] == [patterns.Code.MESHED_FACE]
+    assert max(blank.size) == pytest.approx(path.length, abs=0.01)  # the mid-surface, developed

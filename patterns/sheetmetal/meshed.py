@@ -74,6 +74,13 @@ class MeshedFace:
         return np.einsum("pj,pjd->pd", bary[rows, near], self.uv[tris[cand[rows, near]]])
 
 
+K_FLAT = 0.5
+"""The K-factor of a meshed face that is flat at its middle, or bent gentler than :data:`FLAT_RT`: as r/t grows
+the neutral layer goes to the middle of the sheet (every published table's last class is 0.5)."""
+FLAT_RT = 100.0
+"""An inside radius over this many thicknesses is as good as flat for a material's K-factor."""
+
+
 def inside_radius(f: SheetFace, thickness: float, concave: bool) -> float:
     """A face's inside bend radius at its middle, mm: its tightest radius of curvature there, less the
     thickness when the skin is on the outside of the bend (0 where it is flat)."""
@@ -102,7 +109,11 @@ def mesh_face(f: SheetFace, thickness: float, k_factor: float | Callable, name: 
     normals = np.asarray(trimesh.Trimesh(vertices, tris, process=False).vertex_normals)
     u, v = uv_mid(f.face)
     concave = float(np.mean((vertices - point(f, u, v)) @ normal(f, u, v))) > 0  # curving towards its normal
-    k = k_factor(inside_radius(f, thickness, concave)) if callable(k_factor) else k_factor
+    radius = inside_radius(f, thickness, concave)
+    if callable(k_factor):  # a material's K; flat at its middle (or gentler than any table's r/t): the mid-plane
+        k = K_FLAT if not np.isfinite(radius) or radius > FLAT_RT * thickness else k_factor(radius)
+    else:
+        k = k_factor
     into = k * thickness if concave else (1 - k) * thickness  # the neutral surface, into the sheet
     result = flatten_mesh(vertices - into * normals, tris, name=f"{name} face {f.index}")
     uv = np.array(result.uv)

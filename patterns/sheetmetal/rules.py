@@ -142,6 +142,14 @@ def hole_clearance(thickness: float, allowance: float, *, die_width: float = DIE
     return max(0.5 * die_width * thickness - 0.5 * allowance, min_clearance * thickness)
 
 
+def _across(z: _Zone, ring) -> bool:
+    """Whether a cut crosses a bend's zone from one tangent line to the other, or runs over an end of it (a
+    relief or a window); a hole that only bites into the zone from one side is not across it."""
+    side = [shapely.LineString(z.at(np.array([0.0, z.length]), np.array([v, v]))) for v in (-z.half, z.half)]
+    ends = [shapely.LineString(z.at(np.array([s, s]), np.array([-z.half, z.half]))) for s in (0.0, z.length)]
+    return all(ring.intersects(line) for line in side) or any(ring.intersects(line) for line in ends)
+
+
 def holes_near_bends(blank, *, die_width: float = DIE_WIDTH, min_clearance: float = MIN_HOLE_CLEARANCE) -> list:
     """``hole-near-bend`` notes: every (hole, bend) closer than :func:`hole_clearance`."""
     out = []
@@ -152,8 +160,8 @@ def holes_near_bends(blank, *, die_width: float = DIE_WIDTH, min_clearance: floa
             bend = blank.bends[z.index]
             zone = z.polygon
             need = hole_clearance(blank.thickness, bend.allowance, die_width=die_width, min_clearance=min_clearance)
-            if ring.intersects(zone) and not zone.covers(ring):
-                continue  # a cut across the bend: a relief, or a window the bend is interrupted by
+            if ring.intersects(zone) and not zone.covers(ring) and _across(z, ring):
+                continue  # a cut across the bend: a relief at its end, or a window the bend is interrupted by
             d = float(zone.distance(ring))
             if d >= need:
                 continue

@@ -63,8 +63,8 @@ def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: s
     if largest.kind == "cylinder" and any(owners == (largest.index, largest.index) for owners in topology.edge_faces):
         raise InputError(f"{name}: a closed tube (face {largest.index} goes all the way round, with no seam): "
                          f"cut it along a line of its axis first")
-    planes = sorted((f for f in faces if f.kind == "plane"), key=lambda f: (-round(f.area / largest.area, 9),
-                                                                          -_inwards(f, faces)))
+    planes = sorted((f for f in faces if f.kind == "plane"), key=lambda f: -f.area)
+    planes = _equal_sides_inside_first(planes, faces)
     if not planes:
         raise InputError(f"{name}: not a sheet-metal part: it has no planar face")
     if fixed_face is not None and (fixed_face >= len(faces) or faces[fixed_face].kind != "plane"):
@@ -91,15 +91,30 @@ def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: s
     raise first
 
 
-def _inwards(f, faces) -> float:
-    """How far the part's surface lies on the outward side of planar face ``f`` (its faces' mid points,
-    weighted by area, mm): the inside of a tray's base faces its walls.  Of two faces of one area (a plate's
-    two sides) the one the flanges rise from is fixed first, whatever order the file lists them in."""
-    u, v = uv_mid(f.face)
-    n, p = normal(f, u, v), point(f, u, v)
+SAME_AREA = 1e-6
+"""Planar faces whose areas differ by less than this share of the larger are of one area (a plate's two sides)."""
+
+
+def _equal_sides_inside_first(planes: list, faces) -> list:
+    """``planes`` (by area, largest first) with each run of faces of one area ordered by how far the part's
+    surface lies on their outward side (its faces' mid points, weighted by area): of a plate's two sides the
+    one its flanges rise from comes first, whatever order the file lists them in."""
     mids = np.array([point(g, *uv_mid(g.face)) for g in faces])
-    weights = np.array([g.area for g in faces])
-    return float(((mids - p) @ n * weights).sum() / weights.sum())
+    weights = np.array([g.area for g in faces]) / sum(g.area for g in faces)
+
+    def inwards(f) -> float:
+        u, v = uv_mid(f.face)
+        return float(((mids - point(f, u, v)) @ normal(f, u, v) * weights).sum())
+
+    out, k = [], 0
+    while k < len(planes):
+        j = k
+        while j + 1 < len(planes) and planes[k].area - planes[j + 1].area <= SAME_AREA * planes[k].area:
+            j += 1
+        run = planes[k:j + 1]
+        out += sorted(run, key=lambda f: -inwards(f)) if len(run) > 1 else run
+        k = j + 1
+    return out
 
 
 def _thickness(faces, fixed, name) -> float:
