@@ -89,9 +89,12 @@ def sequence(polygon: shapely.Polygon, lines) -> tuple:
     tuple of int
         The bends' indices, first bent first.
     """
-    outer = [min(flange_depths(polygon, line)) for line in lines]
-    length = [float(np.linalg.norm(np.subtract(*np.asarray(line).reshape(2, 2)))) for line in lines]
+    return _order([min(flange_depths(polygon, line)) for line in lines], lines)
 
+
+def _order(outer: list, lines) -> tuple:
+    """:func:`sequence` from each bend's outer flange depth, mm, already measured."""
+    length = [float(np.linalg.norm(np.subtract(*np.asarray(line).reshape(2, 2)))) for line in lines]
     # depths and lengths counted in steps of TIE: a total order (a comparison "within TIE" is not transitive,
     # and the report and the drawing, measured on differently sampled outlines, could then number a near tie
     # apart)
@@ -163,13 +166,14 @@ def bend_rows(part: str, polygon: shapely.Polygon, bends, *, scale: float = 1.0)
     tuple of BendRow
     """
     bends = list(bends)
-    order = sequence(polygon, [b.line for b in bends])
+    outer = [min(flange_depths(polygon, b.line)) for b in bends]  # measured once: the order and the rows
+    order = _order(outer, [b.line for b in bends])
     rows = []
     for rank, i in enumerate(order, start=1):
         b = bends[i]
         (x1, y1), (x2, y2) = np.asarray(b.line, dtype=np.float64) * scale
         rows.append(BendRow(part, rank, b.direction, float(b.angle), float(b.inside_radius) * scale,
                             float(np.linalg.norm(np.subtract(*b.line))) * scale, b.k_factor,
-                            float(b.allowance) * scale, min(flange_depths(polygon, b.line)) * scale,
+                            float(b.allowance) * scale, outer[i] * scale,
                             float(x1), float(y1), float(x2), float(y2)))
     return tuple(rows)

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from .errors import ExportError, InputError
 
-__all__ = ["Outputs", "atomic_output", "check_input_file", "child_python", "output_target", "same_file"]
+__all__ = ["Outputs", "atomic_output", "check_input_file", "child_python", "csv_table", "output_target", "same_file"]
 
 TEMP_PREFIX = ".~patterns-"
 """Temporary files start with this (and are removed when a write fails)."""
@@ -295,3 +295,16 @@ def child_python() -> str | None:
     if Path(sys.executable).name.startswith("python"):
         return sys.executable
     return shutil.which(f"python{sys.version_info.major}.{sys.version_info.minor}") or shutil.which("python3")
+
+
+def csv_table(fh, columns, *, where: str, what: str):
+    """A ``csv.DictReader`` over ``fh`` whose header (any case, spaces around) names every one of ``columns``;
+    InputError naming ``where`` and the columns missing otherwise (``what``: "a bend table")."""
+    import csv
+
+    reader = csv.DictReader(fh)
+    header = [h.strip().lower() for h in (reader.fieldnames or [])]
+    missing = [c for c in columns if c not in header]
+    if missing:
+        raise InputError(f"{where}: {what} needs the columns {', '.join(columns)}; missing {', '.join(missing)}")
+    return reader

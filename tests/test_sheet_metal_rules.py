@@ -21,6 +21,8 @@ import patterns
 from patterns.cli import main
 from patterns.sheetmetal.rules import manufacturability, open_contours
 
+from .test_unfold import bent_strip
+
 T, R, K, WIDTH = 1.0, 1.0, 0.47, 40.0  # the sheet, inside radius, K-factor and the flange's width, mm
 ALLOWANCE = np.pi / 2 * (R + K * T)  # the 90 degree bend's developed width: 2.3091 mm
 CLEARANCE = 3 * T - ALLOWANCE / 2  # half a 6 t V-die from the centre line, from the zone's edge: 1.8455 mm (> 1.5 t)
@@ -28,21 +30,8 @@ CLEARANCE = 3 * T - ALLOWANCE / 2  # half a 6 t V-die from the centre line, from
 
 def bent(*, la: float, lb: float, r: float = R, t: float = T, width: float = WIDTH, angle: float = 90.0):
     """A strip bent once about the y axis: the base along -x (z in [-t, 0], la long), the bend's inside
-    tangent line at x = 0, the flange lb long beyond the bend; y in [0, width]."""
-    th = np.radians(angle)
-
-    def arc(rad, frac):
-        a = -np.pi / 2 + th * frac
-        return (rad * np.cos(a), 0.0, r + rad * np.sin(a))
-
-    d = np.array([np.cos(th), 0.0, np.sin(th)])
-    i1, i2, o1, o2 = (0, 0, 0), arc(r, 1), (0, 0, -t), arc(r + t, 1)
-    i3, o3 = tuple(np.array(i2) + lb * d), tuple(np.array(o2) + lb * d)
-    e = bd.Edge
-    edges = [e.make_line((-la, 0, 0), i1), e.make_three_point_arc(i1, arc(r, 0.5), i2), e.make_line(i2, i3),
-             e.make_line(i3, o3), e.make_line(o3, o2), e.make_three_point_arc(o2, arc(r + t, 0.5), o1),
-             e.make_line(o1, (-la, 0, -t)), e.make_line((-la, 0, -t), (-la, 0, 0))]
-    return bd.extrude(bd.Face(bd.Wire(edges)), amount=width, dir=(0, 1, 0))
+    tangent line at x = 0, the flange lb long beyond the bend; y in [0, width] (test_unfold's strip)."""
+    return bent_strip(la=la, lb=lb, r=r, t=t, width=width, angle=angle)
 
 
 def _plate(x0, x1, y0, y1):

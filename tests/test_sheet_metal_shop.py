@@ -22,7 +22,7 @@ import patterns
 from patterns.bendsheet import COLUMNS
 from patterns.cli import main
 
-from .test_unfold import bent_strip, conical_sheet
+from .test_unfold import bent_strip, conical_sheet, spline_strip
 
 T, R, WIDTH = 2.0, 3.0, 40.0
 Z_PROFILE = [(-40, 0), (0, 0), (0, 30), (60, 30)]  # flange A 36 mm straight, web 22, flange C 56 (centreline R 4)
@@ -303,27 +303,6 @@ def test_convex_conical_bend_takes_its_neutral_layer_from_the_inside(tmp_path):
         assert blank.perimeter == pytest.approx(2 * length + 2 * generator + phi * (s_a + s_b), rel=1e-6)
         directions.append(blank.bends[0].direction)
     assert sorted(directions) == ["down", "up"]  # one skin concave, the other convex
-
-
-def spline_strip(*, r=2.0, t=1.5, width=30.0):
-    """A strip bent 90 degrees whose bend is drawn as splines (an extrusion surface, meshed when unfolded):
-    flanges 60 and 40 mm on both skins."""
-    th = np.radians(90.0)
-
-    def arc(rad, frac):
-        a = -np.pi / 2 + th * frac
-        return (rad * np.cos(a), 0.0, r + rad * np.sin(a))
-
-    i2, o2 = arc(r, 1), arc(r + t, 1)
-    fr = np.linspace(0, 1, 9)
-    edge = bd.Edge
-    edges = [edge.make_line((-60, 0, 0), (0, 0, 0)),
-             edge.make_spline([arc(r, x) for x in fr], tangents=[(1, 0, 0), (0, 0, 1)]),
-             edge.make_line(i2, (r, 0, r + 40)), edge.make_line((r, 0, r + 40), (r + t, 0, r + 40)),
-             edge.make_line((r + t, 0, r + 40), o2),
-             edge.make_spline([arc(r + t, x) for x in fr[::-1]], tangents=[(0, 0, -1), (-1, 0, 0)]),
-             edge.make_line((0, 0, -t), (-60, 0, -t)), edge.make_line((-60, 0, -t), (-60, 0, 0))]
-    return bd.extrude(bd.Face(bd.Wire(edges)), amount=width, dir=(0, 1, 0))
 
 
 @pytest.mark.slow

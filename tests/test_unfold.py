@@ -64,6 +64,27 @@ def bent_strip(*, la=60.0, lb=40.0, width=30.0, r=2.0, t=1.5, angle=90.0, hole=0
     return solid
 
 
+def spline_strip(*, r=2.0, t=1.5, width=30.0):
+    """A strip bent 90 degrees whose bend is drawn as splines (an extrusion surface, meshed when unfolded):
+    flanges 60 and 40 mm on both skins."""
+    th = np.radians(90.0)
+
+    def arc(rad, frac):
+        a = -np.pi / 2 + th * frac
+        return (rad * np.cos(a), 0.0, r + rad * np.sin(a))
+
+    i2, o2 = arc(r, 1), arc(r + t, 1)
+    fr = np.linspace(0, 1, 9)
+    edge = bd.Edge
+    edges = [edge.make_line((-60, 0, 0), (0, 0, 0)),
+             edge.make_spline([arc(r, x) for x in fr], tangents=[(1, 0, 0), (0, 0, 1)]),
+             edge.make_line(i2, (r, 0, r + 40)), edge.make_line((r, 0, r + 40), (r + t, 0, r + 40)),
+             edge.make_line((r + t, 0, r + 40), o2),
+             edge.make_spline([arc(r + t, x) for x in fr[::-1]], tangents=[(0, 0, -1), (-1, 0, 0)]),
+             edge.make_line((0, 0, -t), (-60, 0, -t)), edge.make_line((-60, 0, -t), (-60, 0, 0))]
+    return bd.extrude(bd.Face(bd.Wire(edges)), amount=width, dir=(0, 1, 0))
+
+
 def _need_parts():
     if not SHEETMETAL.is_dir():
         pytest.skip(f"{SHEETMETAL} is absent (the shared sheet-metal parts sit beside the repository in CI)")
@@ -142,25 +163,10 @@ def test_a_bend_that_is_no_cylinder_is_meshed_and_says_so():
     """The bend of a strip drawn as splines (an extrusion surface, not a cylinder) is meshed, moved to
     its neutral surface and flattened: close to the exact length, with its strain reported."""
     r, t, k, width = 2.0, 1.5, 0.4, 30.0
-    th = np.radians(90.0)
-
-    def arc(rad, frac):
-        a = -np.pi / 2 + th * frac
-        return (rad * np.cos(a), 0.0, r + rad * np.sin(a))
-
-    i2, o2 = arc(r, 1), arc(r + t, 1)
-    fr = np.linspace(0, 1, 9)
-    edge = bd.Edge
-    edges = [edge.make_line((-60, 0, 0), (0, 0, 0)),
-             edge.make_spline([arc(r, x) for x in fr], tangents=[(1, 0, 0), (0, 0, 1)]),
-             edge.make_line(i2, (r, 0, r + 40)), edge.make_line((r, 0, r + 40), (r + t, 0, r + 40)),
-             edge.make_line((r + t, 0, r + 40), o2),
-             edge.make_spline([arc(r + t, x) for x in fr[::-1]], tangents=[(0, 0, -1), (-1, 0, 0)]),
-             edge.make_line((0, 0, -t), (-60, 0, -t)), edge.make_line((-60, 0, -t), (-60, 0, 0))]
-    part = bd.extrude(bd.Face(bd.Wire(edges)), amount=width, dir=(0, 1, 0))
+    part = spline_strip(r=r, t=t, width=width)
     assert "EXTRUSION" in {f.geom_type.name for f in part.faces()}
     blank = patterns.unfold(part, k_factor=k)
-    length = 100.0 + th * (r + k * t)
+    length = 100.0 + np.pi / 2 * (r + k * t)
     assert max(blank.size) == pytest.approx(length, abs=0.05)  # the mesh's chords and relaxation: < 0.05 mm
     assert blank.area == pytest.approx(length * width, rel=5e-4)
     (finding,) = blank.findings

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..files import check_input_file
+from ..files import check_input_file, csv_table
 
 __all__ = ["BUNDLED", "COLUMNS", "MaterialTable", "bundled_materials", "read_material_table"]
 
@@ -130,12 +130,7 @@ def read_material_table(path) -> MaterialTable:
 
 def _parse(fh, path: str | None) -> MaterialTable:
     where = path or "the bundled material table"
-    reader = csv.DictReader(fh)
-    header = [h.strip().lower() for h in (reader.fieldnames or [])]
-    missing = [c for c in COLUMNS if c not in header]
-    if missing:
-        raise InputError(f"{where}: a material table needs the columns {', '.join(COLUMNS)}; missing "
-                         f"{', '.join(missing)}")
+    reader = csv_table(fh, COLUMNS, where=where, what="a material table")
     rows, materials = [], []
     try:
         for line, row in enumerate(reader, start=2):

@@ -176,25 +176,23 @@ def holes_near_bends(blank, *, die_width: float = DIE_WIDTH, min_clearance: floa
     return out
 
 
-def _flat_beyond(z: _Zone, side: float, s: float, outline: shapely.Polygon, others: list, reach: float):
-    """Length, mm, of material square to the bend from its tangent line at ``s`` on ``side`` (+1/-1), to the
-    outline or the next bend's zone; None where no flange starts there."""
+def _flat_beyond(z: _Zone, side: float, s: np.ndarray, boundary, outline: shapely.Polygon, others: list,
+                 reach: float) -> np.ndarray:
+    """(k,) float64, mm: the length of material square to the bend from its tangent line at each of the
+    stations ``s`` on ``side`` (+1/-1), to the outline (its ``boundary``) or the next bend's zone; NaN where no
+    flange starts there."""
     eps = 1e-6 * max(1.0, reach)
-    start = z.at(s, side * z.half)
-    if not outline.contains(shapely.Point(start + side * 10 * eps * z.n)):
-        return None
-    ray = shapely.LineString([start, start + side * reach * z.n])
-    cuts = [outline.boundary.intersection(ray)] + [o.intersection(ray) for o in others]
-    ends = [reach]
-    for geom in cuts:
-        if geom.is_empty:
-            continue
-        pts = shapely.get_coordinates(geom)
-        d = (pts - start) @ (side * z.n)
-        d = d[d > 10 * eps]
-        if len(d):
-            ends.append(float(d.min()))
-    return min(ends)
+    starts = z.at(s, np.full(len(s), side * z.half))
+    inside = shapely.contains_xy(outline, *(starts + side * 10 * eps * z.n).T)
+    rays = shapely.linestrings(np.stack([starts, starts + side * reach * z.n], axis=1))
+    ends = np.full(len(s), reach)
+    for other in [boundary, *others]:
+        cuts = shapely.intersection(rays, other)
+        pts, which = shapely.get_coordinates(cuts, return_index=True)
+        d = (pts - starts[which]) @ (side * z.n)
+        far = d > 10 * eps
+        np.minimum.at(ends, which[far], d[far])
+    return np.where(inside, ends, np.nan)
 
 
 def short_flanges(blank, *, die_width: float = DIE_WIDTH) -> list:
@@ -202,6 +200,7 @@ def short_flanges(blank, *, die_width: float = DIE_WIDTH) -> list:
     out = []
     zones = _zones(blank, die_width)
     outline = _valid(blank.outline.polygon)
+    boundary = outline.boundary
     x0, y0, x1, y1 = outline.bounds
     reach = 2 * float(np.hypot(x1 - x0, y1 - y0))
     t = blank.thickness
@@ -214,11 +213,12 @@ def short_flanges(blank, *, die_width: float = DIE_WIDTH) -> list:
         margin = min(t, 0.25 * z.length)
         stations = np.linspace(margin, z.length - margin, STATIONS)
         for side in (-1.0, 1.0):
-            flats = [(f, s) for s in stations
-                     if (f := _flat_beyond(z, side, s, outline, others, reach)) is not None]
+            lengths = _flat_beyond(z, side, stations, boundary, outline, others, reach)
+            flats = [(f, s) for f, s in zip(lengths, stations) if not np.isnan(f)]
             if not flats:
                 continue
             flat, s = sorted(flats)[len(flats) // 2]  # the median: a chamfered or notched end is not the flange
+            flat = float(flat)
             if flat + setback >= need:
                 continue
             start = z.at(s, side * z.half)

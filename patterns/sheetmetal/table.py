@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..files import check_input_file
+from ..files import check_input_file, csv_table
 from ..options import Options, label, option
 from .corners import CORNER_RELIEFS
 from .materials import MaterialTable, _path_or_table, bundled_materials
@@ -87,12 +87,7 @@ def read_bend_table(path) -> BendTable:
     rows = []
     try:
         with open(path, newline="", encoding="utf-8") as fh:
-            reader = csv.DictReader(fh)
-            header = [h.strip().lower() for h in (reader.fieldnames or [])]
-            missing = [n for n in need if n not in header]
-            if missing:
-                raise InputError(f"{path}: a bend table needs the columns {', '.join(need)}; "
-                                 f"missing {', '.join(missing)}")
+            reader = csv_table(fh, need, where=str(path), what="a bend table")
             for line, row in enumerate(reader, start=2):
                 row = {k.strip().lower(): v for k, v in row.items() if k is not None}
                 try:
