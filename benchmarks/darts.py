@@ -15,7 +15,14 @@ a single-panel flattening with no limit; there is no open dart tool to race).
 * ``cup``: ``samples/cup.step``, four quarter-sphere gores of R 100 mm;
 * ``four gores``: the R 150 hemisphere cut into four quarter gores in build123d.
 
-    python benchmarks/darts.py [--limit 0.03]
+Then (``--shapes``, issue 36) the curved faces of ``patterns.samples.DOMES``
+(a spline bowl, oblate and prolate domes, an ellipsoid, a torus patch, a
+saddle, an asymmetric freeform cup), each with darts and then in gores: the
+worst and RMS strain, the darts' total 3D length or the gore count, whether the
+limit was met, the largest difference between the two flat sides of a gore
+seam, and the time against the dartless flattening.
+
+    python benchmarks/darts.py [--limit 0.03] [--shapes]
 """
 
 from __future__ import annotations
@@ -33,7 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_flatten as bench  # libigl's ARAP, as the flattening benchmark runs it
 
 import patterns
-from patterns import surfaces
+from patterns import samples, surfaces
 from patterns.measure import strain_rms, triangle_strains
 from patterns.reading import mesh_model
 
@@ -67,8 +74,12 @@ def timed(fn):
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--limit", type=float, default=0.03)
-    limit = parser.parse_args(argv).limit
+    parser.add_argument("--shapes", action="store_true", help="the curved faces of patterns.samples.DOMES")
+    args = parser.parse_args(argv)
+    limit = args.limit
     print(f"strain limit {limit:.1%}\n")
+    if args.shapes:
+        return shapes(limit)
     print("| dome | triangles | worst, no darts | darts | worst | RMS | dart length / gore bound "
           "| legs differ by | time | / dartless | / libigl ARAP |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
@@ -89,6 +100,33 @@ def main(argv=None) -> int:
               f"| {length:,.0f} / {gore_bound(radius, limit, share):,.0f} mm "
               f"({length / gore_bound(radius, limit, share):.2f}) | {legs:.3f} mm | {t_darts:.1f} s "
               f"| {t_darts / t_plain:.0f} x | {t_darts / t_igl:.0f} x |", flush=True)
+    return 0
+
+
+def worst_of(pattern) -> float:
+    return max(float(triangle_strains(p.vertices, p.faces, p.uv).magnitude.max()) for p in pattern.panels)
+
+
+def shapes(limit: float) -> int:
+    """The table of docs/garments.md "Darts and gores on other curved shapes"."""
+    print("| shape | triangles | worst, no darts | darts | worst | RMS | dart length | met | time | / dartless "
+          "| gores | worst | gore sides differ by | met | time |")
+    print("|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---|---:|")
+    for name, make in samples.DOMES.items():
+        model = patterns.load(make())
+        plain, t_plain = timed(partial(patterns.flatten, model))
+        darted, t_darts = timed(partial(patterns.flatten, model, max_strain=limit))
+        gored, t_gores = timed(partial(patterns.flatten, model, max_strain=limit, gores=True))
+        darts = [d for p in darted.panels for d in p.darts]
+        rms = max(strain_rms(p.vertices, p.faces, p.uv) for p in darted.panels)
+        after, in_gores = worst_of(darted), worst_of(gored)
+        new = gored.seams[len(model.seams):]
+        sides = max((abs(fs.flat_lengths[0] - fs.flat_lengths[1]) for fs in new), default=0.0)
+        n = sum(len(p.faces) for p in model.panels)
+        print(f"| {name} | {n:,} | {worst_of(plain):.1%} | {len(darts)} | {after:.2%} | {rms:.2%} "
+              f"| {sum(d.length_3d for d in darts):,.0f} mm | {'yes' if after <= limit else 'no'} | {t_darts:.1f} s "
+              f"| {t_darts / t_plain:.0f} x | {len(gored.panels)} | {in_gores:.2%} | {sides:.3f} mm "
+              f"| {'yes' if in_gores <= limit else 'no'} | {t_gores:.1f} s |", flush=True)
     return 0
 
 

@@ -43,7 +43,7 @@ from .measure import Distortion, StrainStats, distortion
 from .mesh import Connectivity, validate_mesh
 from .model import Bookkeeping, Model, Panel, Seam, Surface, SurfaceKind
 from .nesting import Layout, NestOptions, layout
-from .pattern import Dart, FlatPanel, FlatSeam, Pattern
+from .pattern import Dart, DartSearch, FlatPanel, FlatSeam, Pattern
 from .pieces import Drawing, Piece, PieceOptions, pieces_of
 from .predicates import Overlap, overlap_verdict
 from .reading import LoadOptions, load, read_cad, read_mesh
@@ -69,6 +69,7 @@ __all__ = [
     "Connectivity",
     "Cut",
     "Dart",
+    "DartSearch",
     "DartReport",
     "Distortion",
     "Drawing",

@@ -362,6 +362,35 @@ def _usable(flat, report, opts) -> list:
     return out
 
 
+def _dart_notes(flat, mag, uv, faces) -> list:
+    """The note on a panel's darts: how many and how long, and whether they met the limit they were
+    cut for; where they did not (or there was none to cut), the best strain reached and where."""
+    search = flat.dart_search
+    if not flat.darts and (search is None or search.met):
+        return []
+    i = int(np.argmax(mag))
+    worst, at = float(mag[i]), uv[faces[i]].mean(axis=0)
+    where = f"{worst:.2%} at ({at[0]:.1f}, {at[1]:.1f}) mm"
+    if flat.darts:
+        tips = np.array([uv[d.tip] for d in flat.darts])
+        length = sum(d.length_3d for d in flat.darts)
+        cut = f"{counted(len(flat.darts), 'dart')} cut"
+        of = f" ({length:.1f} mm of cuts; points: their tips)"
+    else:
+        tips, cut, of = at[None, :], "no dart cut", ""
+    if search is None or (search.met and search.sewn):
+        text = f"panel {flat.name}: {cut} to keep the strain within the limit{of}"
+    else:
+        limit, tried = search.limit, len(search.tries)
+        text = (f"panel {flat.name}: {cut}{of}; the strain limit {limit:.2%} was not met within {search.max_darts} "
+                f"darts ({tried} cuts measured): the best reached is {where}, from {search.before:.2%} "
+                f"without darts")
+        if search.met and not search.sewn:
+            text = (f"panel {flat.name}: {cut}{of} keep the strain within {limit:.2%}, but their legs could not "
+                    f"be held to equal lengths with the panel's seams")
+    return [Finding(Code.DARTS, Severity.NOTE, (flat.name,), tips, (), None, text)]
+
+
 SEAM_LENGTH_TOLERANCE = 1e-3
 """A held seam side whose flat length is off its held length by more than this fraction is reported."""
 
@@ -388,12 +417,7 @@ def _panel_report(flat, max_strain):
                 f"({len(above)} triangles), up to {mag[worst]:.2%} at ({centre[0]:.1f}, {centre[1]:.1f}) mm"))
     findings += _panel_overlaps(flat)
     res = flat.flattening
-    if flat.darts:
-        tips = np.array([uv[d.tip] for d in flat.darts])
-        length = sum(d.length_3d for d in flat.darts)
-        findings.append(Finding(Code.DARTS, Severity.NOTE, (flat.name,), tips, (),
-                                None, f"panel {flat.name}: {counted(len(flat.darts), 'dart')} cut to keep the strain within "
-                                      f"the limit ({length:.1f} mm of cuts; points: their tips)"))
+    findings += _dart_notes(flat, mag, uv, faces)
     if not res.converged:
         findings.append(Finding(Code.NOT_CONVERGED, Severity.NOTE, (flat.name,), np.zeros((0, 2)), (), None,
                                 f"panel {flat.name}: the relaxation stopped after {res.iterations} iterations "

@@ -26,13 +26,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .mesh import edge_lengths, face_areas, side_vectors, unique_edges
+from .mesh import corner_angles, edge_lengths, face_areas, side_vectors, unique_edges
 
 __all__ = [
     "Distortion",
     "StrainStats",
     "TriangleStrain",
     "affine_coefficients",
+    "angle_defects",
     "area_ratio",
     "boundary_lengths",
     "distortion",
@@ -359,6 +360,32 @@ def no_strain(vertices: np.ndarray, faces: np.ndarray) -> TriangleStrain:
     for x in arrays:
         x.setflags(write=False)
     return TriangleStrain(*arrays)
+
+
+def angle_defects(vertices: np.ndarray, faces: np.ndarray, *, loops=()) -> np.ndarray:
+    """The surface's Gaussian curvature gathered at each vertex: its angle defect.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64
+    loops : sequence of (k,) int, optional
+        The boundary loops; their vertices get 0 (a boundary vertex has no
+        defect of its own).
+
+    Returns
+    -------
+    (n,) float64
+        ``2 pi`` minus the sum of the corner angles round each vertex,
+        radians: positive on a dome, negative on a saddle, 0 on a plane or a
+        cylinder; the defects of a surface patch sum to its total curvature.
+    """
+    angles = corner_angles(np.asarray(vertices, dtype=np.float64), np.asarray(faces, dtype=np.int64))
+    total = np.bincount(np.asarray(faces).ravel(), weights=angles.ravel(), minlength=len(vertices))
+    defect = 2.0 * np.pi - total
+    for loop in loops:
+        defect[np.asarray(loop, dtype=np.int64)] = 0.0
+    return defect
 
 
 def weighted_percentile(values: np.ndarray, weights: np.ndarray, q: float) -> float:

@@ -23,7 +23,7 @@ from .options import check_number
 from .predicates import Overlap, flat_polygon
 from .text import counted
 
-__all__ = ["Dart", "FlatPanel", "FlatSeam", "Flattening", "Pattern"]
+__all__ = ["Dart", "DartSearch", "FlatPanel", "FlatSeam", "Flattening", "Pattern"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -95,6 +95,41 @@ class Flattening:
         return distortion(self.vertices, self.faces, self.uv, loops=self.loops)
 
 
+@dataclass(frozen=True)
+class DartSearch:
+    """How ``flatten(..., max_strain=...)`` looked for a panel's darts, and whether it met the limit.
+
+    Attributes
+    ----------
+    limit : float
+        The strain limit the darts were cut for (0.03 = 3 %).
+    max_darts : int
+        The most darts allowed.
+    before : float
+        The worst triangle's principal strain without darts.
+    worst : float
+        The worst triangle's principal strain of the panel as cut.
+    met : bool
+        ``worst <= limit``.
+    sewn : bool
+        The darts' legs were held to one length each (False: the relaxation
+        could not hold them with the panel's seams, and the legs are left as
+        they fell).
+    tries : tuple of (int, float, float)
+        Every flattening tried, in order: ``(darts, core radius mm, worst
+        strain)``; the darts ran from the outline to a circle of that radius
+        about the crown (``inf``: the try could not be cut or its seams held).
+    """
+
+    limit: float
+    max_darts: int
+    before: float
+    worst: float
+    met: bool
+    sewn: bool = True
+    tries: tuple = ()
+
+
 @dataclass(frozen=True, eq=False)
 class Dart:
     """A dart: a cut from the outline into a panel, whose two legs are sewn together.
@@ -157,6 +192,8 @@ class FlatPanel:
     """A mirror image of its source (the left piece of a left and right pair): 3D panel and flat
     piece reflected across their first axis, faces and loops turned so that both stay
     counter-clockwise."""
+    dart_search: DartSearch | None = None
+    """How the darts were looked for (None: no ``max_strain`` was given, or the panel is exact)."""
 
     def copy(self, name: str, *, source: int, mirrored: bool = False) -> FlatPanel:
         """Another piece of this panel, named ``name`` (a mirror image if ``mirrored``)."""
@@ -179,7 +216,8 @@ class FlatPanel:
                               directrix=None if surface.directrix is None else surface.directrix * flip3)
         mirror = replace(panel, vertices=panel.vertices * flip3, faces=panel.faces[:, ::-1],
                          loops=tuple(loop[::-1] for loop in panel.loops), surface=surface)
-        return FlatPanel(name, mirror, flattening, self.placement, self.darts, source, not self.mirrored)
+        return FlatPanel(name, mirror, flattening, self.placement, self.darts, source, not self.mirrored,
+                         self.dart_search)
 
     @property
     def uv(self) -> np.ndarray:

@@ -33,6 +33,24 @@ Two more parts, built here but not bundled as files (the seam tests and
   (one freeform face, its rim a quarter circle of 150 mm) closed by three planes.
 * ``sphere_gores`` -- a sphere of radius 100 mm split by two planes through its
   axis: four gores, pole to pole.
+
+Curved faces for darts and gores (:data:`DOMES`; ``benchmarks/darts.py``, issue 36),
+each one build123d face:
+
+* ``spline_bowl`` -- a spline through (0, 0), (60, 8), (90, 30), (100, 60) mm
+  revolved 360 degrees about z: 200 mm across, 60 deep.  The spline leaves
+  the axis 8.5 degrees below horizontal: the bowl's bottom is a shallow cone
+  point.
+* ``oblate_dome`` / ``prolate_dome`` -- a quarter ellipse revolved: semi-axes
+  150 (across) and 90 (high) mm, or 90 and 150.
+* ``ellipsoid_cap`` -- the upper half of an ellipsoid of semi-axes 150, 110
+  and 80 mm (a sphere scaled: a B-spline face).
+* ``torus_patch`` -- the outer half of a torus (major radius 150, minor 50 mm)
+  over a quarter turn: positive curvature everywhere.
+* ``saddle`` -- a B-spline face through z = (x^2 - y^2) / 400 on a 200 mm
+  square: negative curvature everywhere.
+* ``freeform_cup`` -- an asymmetric cup, one B-spline face through a 5 x 5
+  grid of points, 160 x 120 mm and 40 mm deep, its deepest point off centre.
 """
 
 from __future__ import annotations
@@ -41,8 +59,9 @@ from math import pi
 
 import numpy as np
 
-__all__ = ["SAMPLES", "bowl_segment", "cup", "duct_transition", "hopper", "hull_panel", "rolled_cylinder",
-           "sphere_gores", "square_to_round"]
+__all__ = ["DOMES", "SAMPLES", "bowl_segment", "cup", "duct_transition", "ellipsoid_cap", "freeform_cup", "hopper",
+           "hull_panel", "oblate_dome", "prolate_dome", "rolled_cylinder", "saddle", "sphere_gores", "spline_bowl",
+           "square_to_round", "torus_patch"]
 
 
 def duct_transition():
@@ -170,6 +189,79 @@ def bracket(thickness: float = 2.0, radius: float = 3.0, width: float = 40.0):
     part = bd.sweep(plane * bd.Rectangle(width, thickness), path=path, transition=bd.Transition.RIGHT)
     return part - bd.Plane(origin=(30, 0, 0), z_dir=(0, 1, 0)) * bd.Cylinder(4, 50)
 
+
+
+def spline_bowl():
+    """A spline through (0, 0), (60, 8), (90, 30) and (100, 60) mm revolved about z: one face."""
+    import build123d as bd
+
+    profile = bd.Edge.make_spline([(0, 0, 0), (60, 0, 8), (90, 0, 30), (100, 0, 60)])
+    return bd.Face.revolve(profile, 360, bd.Axis.Z)
+
+
+def _ellipse_dome(across: float, high: float):
+    import build123d as bd
+
+    quarter = bd.Edge.make_ellipse(across, high, bd.Plane.XZ, start_angle=0, end_angle=90)
+    return bd.Face.revolve(quarter, 360, bd.Axis.Z)
+
+
+def oblate_dome():
+    """A quarter ellipse of semi-axes 150 mm (across) and 90 mm (high) revolved about z: one face."""
+    return _ellipse_dome(150.0, 90.0)
+
+
+def prolate_dome():
+    """A quarter ellipse of semi-axes 90 mm (across) and 150 mm (high) revolved about z: one face."""
+    return _ellipse_dome(90.0, 150.0)
+
+
+def ellipsoid_cap():
+    """The upper half of an ellipsoid of semi-axes 150, 110 and 80 mm: one B-spline face."""
+    import build123d as bd
+
+    half = bd.Sphere(1.0, arc_size1=0)
+    (face,) = [f for f in half.faces() if f.geom_type != bd.GeomType.PLANE]
+    return bd.scale(face, (150.0, 110.0, 80.0))
+
+
+def torus_patch():
+    """The outer half of a torus (major radius 150, minor 50 mm) over a quarter turn: one face."""
+    import build123d as bd
+
+    arc = bd.Edge.make_circle(50.0, bd.Plane.XZ.offset(0).shift_origin((150, 0, 0)), start_angle=-90, end_angle=90)
+    return bd.Face.revolve(arc, 90, bd.Axis.Z)
+
+
+def saddle():
+    """z = (x^2 - y^2) / 400 over a 200 mm square: one B-spline face through a 9 x 9 grid of points."""
+    import build123d as bd
+
+    grid = np.linspace(-100.0, 100.0, 9)
+    points = [[(x, y, (x * x - y * y) / 400.0) for x in grid] for y in grid]
+    return bd.Face.make_surface_from_array_of_points(points)
+
+
+def freeform_cup():
+    """An asymmetric cup: one B-spline face through a 5 x 5 grid, 160 x 120 mm, 40 mm deep off centre."""
+    import build123d as bd
+
+    depth = [[0, 0, 0, 0, 0], [0, 14, 20, 12, 0], [0, 24, 40, 22, 0], [0, 12, 24, 10, 0], [0, 0, 0, 0, 0]]
+    xs, ys = np.linspace(-80.0, 80.0, 5), np.linspace(-60.0, 60.0, 5)
+    points = [[(x, y, -float(depth[i][j])) for j, x in enumerate(xs)] for i, y in enumerate(ys)]
+    return bd.Face.make_surface_from_array_of_points(points)
+
+
+DOMES = {
+    "spline bowl": spline_bowl,
+    "oblate dome": oblate_dome,
+    "prolate dome": prolate_dome,
+    "ellipsoid": ellipsoid_cap,
+    "torus patch": torus_patch,
+    "saddle": saddle,
+    "freeform cup": freeform_cup,
+}
+"""The curved faces of the dart and gore benchmark, by name (each function returns one face)."""
 
 SAMPLES = {
     "duct_transition.step": duct_transition,

@@ -199,6 +199,18 @@ def test_a_looser_limit_takes_fewer_darts_and_too_few_darts_are_reported(hemisph
     report = patterns.check(two)
     assert not report.ok
     assert any(f.code is patterns.Code.STRAIN_ABOVE_LIMIT for f in report.findings)
+    # Said, never claimed: the note on the darts says the limit was not met, and gives the worst
+    # triangle's strain as measured here, not "to keep the strain within the limit".
+    search = flat.dart_search
+    assert search.limit == LIMIT and search.max_darts == 2 and not search.met
+    assert search.worst == pytest.approx(worst(flat), rel=1e-12) and search.before > 0.3
+    assert all(k <= 2 for k, _, _ in search.tries) and search.tries
+    (note,) = [f.message for f in report.findings if f.code is patterns.Code.DARTS]
+    assert "within the limit" not in note
+    assert "limit 3.00% was not met within 2 darts" in note and f"best reached is {worst(flat):.2%}" in note
+    # Where it was met, the note says so.
+    (met,) = [f.message for f in patterns.check(pattern).findings if f.code is patterns.Code.DARTS]
+    assert pattern.panels[0].dart_search.met and "to keep the strain within the limit" in met
 
 
 @pytest.mark.slow

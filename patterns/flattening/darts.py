@@ -15,21 +15,35 @@ peaks; this module decides the darts of a panel together:
   along the outline's inward normal; the straight line is put into the
   mesh (:func:`patterns.cut.insert_line`), so the legs do not zigzag along
   triangle edges.
-* **How many and how long.**  The fewest darts (up to ``max_darts``) that
-  bring the worst triangle within the limit when as long as they can be
-  (tips kept apart and off the far outline), then all shortened together,
-  by bisection, to the shortest that still meets it.  Each try is one
-  flattening with the panel's seams held.
+* **How many and how long: first from the surface's curvature.**  The
+  crown is where the surface's positive Gaussian curvature (angle defects
+  of the 3D mesh) lies on the dartless layout, its centroid; the tips stop
+  on a circle about it that holds curvature enough to strain the uncut
+  middle by half the limit (a dart runs as far as the curvature it relieves:
+  into a bowl's curved wall, not across its flat bottom); the count is the
+  gore-width estimate (a gore of half-width w on curvature K strains about
+  w² K / 4) over the curvature outside the circle.  Then measured: each try
+  is one flattening with the panel's seams held; where the worst strain
+  lies beyond the tips, the darts run on (all of them, or the one passing
+  nearest the worst triangle); where it lies between them, one dart more;
+  a step that made the worst triangle worse is undone.  A count met at
+  once is tried one lower, and the darts that meet the limit are
+  shortened together by bisection.
+* **Or evenly, by share.**  Where that finds nothing within the limit (a
+  gore's darts run to its corner, not to the middle of its curvature): the
+  fewest darts that meet it when as long as they can be (tips kept apart
+  and off the far outline), all shortened together.
+* **Said.**  Every try is kept in :class:`patterns.DartSearch`
+  (:attr:`patterns.FlatPanel.dart_search`), with whether the limit was met;
+  the report's note never says the darts kept the strain within the limit
+  when they did not.
 * **Sewn.**  The two legs of each dart are held, in total, at one length
   (the mean of the lengths they take when free): they close on each other;
   the seams the darts do not cut keep their held lengths.  A try whose held
   lengths the relaxation could not reach (it stalled: a flap pinned between
   a dart and a seam) is not taken.
 
-Measured (``benchmarks/darts.py``, docs/garments.md): a hemisphere R 150 mm
-(one build123d face, 4,924 triangles) at 3 %: 11 darts, worst triangle
-2.77 %, 2,191 mm of darts against the gore bound of 2,135 mm, legs equal to
-0.002 mm, in 8.7 s.
+Measured: ``benchmarks/darts.py`` and the table in docs/garments.md.
 """
 
 from __future__ import annotations
@@ -40,16 +54,18 @@ import numpy as np
 import shapely
 
 from ..cut import cut_along, insert_line
-from ..measure import triangle_strains
+from ..measure import angle_defects, triangle_strains
 from ..mesh import edge_lengths, polyline_length, unique_edges
-from ..pattern import Dart, Flattening
+from ..pattern import Dart, DartSearch, Flattening
 from .engine import flatten_mesh
 from .seams import seam_edges
 
 __all__ = ["DartLine", "cut_darts", "dart_lines"]
 
 _TIP_GAP = 4.0  # tips at least this many mean flat edge lengths apart, and from the far outline
-_BISECTIONS = 4  # halvings of the common dart length once a count meets the limit
+_BISECTIONS = 2  # halvings of the common dart length once a count meets the limit
+_TRIES = 24  # flattenings the search may spend before the sewing
+_LENGTHEN = 0.7  # a try strained at its tips runs the darts on: the core's radius times this
 _HELD = 1e-3  # a try whose held lengths end further off than this share (a stalled relaxation) is not taken
 _STRETCHED = 0.5  # an outline vertex is on a stretch when its flat edges exceed 3D by this share of the limit
 
@@ -92,34 +108,275 @@ def cut_darts(result: Flattening, limit: float, max_darts: int, held, options: d
 
     Returns
     -------
-    (Flattening, tuple of Dart)
+    (Flattening, tuple of Dart, DartSearch)
         The result unchanged and no dart when it is within the limit already
         or no dart helps; otherwise the darted flattening (the mesh with the
-        dart lines put in and cut) and its darts.  Where no count up to
-        ``max_darts`` meets the limit, the darts that came closest.
+        dart lines put in and cut) and its darts.  Where the limit is not met
+        within ``max_darts``, the darts that came closest.  The search: every
+        try measured, and whether the limit was met.
     """
-    if max_darts < 1 or worst_strain(result) <= limit:
-        return result, ()
+    first = worst_strain(result)
+    if max_darts < 1 or first <= limit:
+        return result, (), DartSearch(limit, max_darts, first, first, first <= limit, True, ())
+    tries = []
+    found, best = _curvature_search(result, limit, max_darts, held, options, tries)
+    if found is None:
+        found, other = _share_search(result, limit, max_darts, held, options, tries)
+        best = min(best, other, key=lambda t: t[0])
+    if found is not None:
+        sewn, darts = found
+        return sewn, darts, DartSearch(limit, max_darts, first, worst_strain(sewn), True, True, tuple(tries))
+    _, flat, darts = best
+    if not darts:
+        return result, (), DartSearch(limit, max_darts, first, first, False, True, tuple(tries))
+    sewn = _sewn(flat, darts, held, options)
+    out = sewn if _kept(sewn) else flat
+    reached = worst_strain(out)
+    if reached >= first:  # sewn, the closest try is no better than no dart at all: none is cut
+        return result, (), DartSearch(limit, max_darts, first, first, False, True, tuple(tries))
+    return out, darts, DartSearch(limit, max_darts, first, reached, reached <= limit, out is sewn, tuple(tries))
+
+
+def _first_sewn(passing, limit, held, options):
+    """Of the tries that met the limit, shortest darts first, the first whose legs sewn keep it:
+    ``(sewn Flattening, darts)`` or None."""
+    for flat, darts in passing:
+        sewn = _sewn(flat, darts, held, options)
+        if _kept(sewn) and worst_strain(sewn) <= limit:
+            return sewn, darts
+    return None
+
+
+def _curvature_search(result, limit, max_darts, held, options, tries):
+    """Darts from the count and length the surface's curvature asks for, then measured: lengthened
+    where the strain is beyond their tips, one more where it is between them.
+
+    Returns ``(found, best)``: ``found`` the sewn flattening and darts that meet the limit, or None;
+    ``best`` the try that came closest, ``(worst, Flattening, darts)``.  Appends every try to ``tries``.
+    """
+    best = (worst_strain(result), result, ())
+    plan = _Plan(result, limit, held, options)
+    state, kept = (plan.first_count(max_darts), plan.core, ()), None  # (darts, core radius, points run past)
+    found = None
+    while len(tries) < _TRIES and 1 <= state[0] <= max_darts:
+        k, core, points = state
+        tried = plan.attempt(k, core, points)
+        worst = np.inf if tried is None else tried[0]
+        tries.append((k, core, float(worst)))
+        if tried is not None and worst < best[0]:
+            best = tried[:3]
+        if tried is not None and worst <= limit:
+            found = (state, tried)
+            break
+        if kept is not None and worst >= kept[1] and kept[0][0] == k:
+            (_, core, points), at = kept[0], kept[2]  # the last step made it worse: undone, and one dart more
+            state = (k + 1, core, points)
+            if k == max_darts and at is not None and not any(np.array_equal(at, p) for p in points) \
+                    and plan.lengths(k, core, points + (at,)) is not None:
+                state = (k, core, points + (at,))  # or, with no dart more allowed, the nearest run on past it
+            kept = (kept[0], kept[1], None)
+            continue
+        at = None if tried is None else plan.worst_point(tried)
+        kept = (state, worst, at)
+        state = (k + 1, core, points)  # the strain between the darts: one more
+        if tried is None:
+            continue
+        beyond = np.linalg.norm(at - plan.crown) < core + plan.gap  # the worst triangle is beyond the tips
+        if beyond and plan.strained_at_tips(tried, core) and core > 1.01 * plan.min_core(k):
+            state = (k, max(core * _LENGTHEN, plan.min_core(k)), points)  # run every dart on
+        elif (beyond or k == max_darts) and plan.lengths(k, core, points + (at,)) is not None:
+            state = (k, core, points + (at,))  # the dart passing nearest runs on past it
+    if found is None:
+        return None, best
+    (k, core, points), tried = found
+    passing = [(core, tried)]
+    fewer = k - 1  # the count came from an estimate: fewer darts may do
+    while fewer >= 1 and len(tries) < _TRIES + _BISECTIONS and k == tries[0][0]:
+        again = plan.attempt(fewer, core, points)
+        tries.append((fewer, core, np.inf if again is None else float(again[0])))
+        if again is None or again[0] > limit:
+            break
+        k, passing, fewer = fewer, [(core, again)], fewer - 1
+    lo, hi = core, min(plan.outer, 1.6 * core)  # shortened together: the core widened while the limit holds
+    for _ in range(_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        again = plan.attempt(k, mid, points)
+        tries.append((k, mid, np.inf if again is None else float(again[0])))
+        if again is not None and again[0] <= limit:
+            passing.append((mid, again))
+            lo = mid
+        else:
+            hi = mid
+    passing.sort(key=lambda item: -item[0])  # the widest core, the shortest darts, first
+    return _first_sewn([(t[1], t[2]) for _, t in passing], limit, held, options), best
+
+
+def _share_search(result, limit, max_darts, held, options, tries):
+    """Darts evenly spaced, all run to one share of their reach: the fewest (1, 2, ...) that meet the
+    limit when as long as they can be (tips kept apart and off the far outline), then shortened
+    together by bisection.  What :func:`_curvature_search` falls back on where its crown is not where
+    the darts meet (a gore's darts run to its corner).  Returns ``(found, best)`` as it does."""
     h = float(np.mean(edge_lengths(result.uv, unique_edges(result.faces))))
-    best = (worst_strain(result), result, ())  # the try that came closest, legs not yet sewn
+    gap = _TIP_GAP * h
+    best = (worst_strain(result), result, ())
     for k in range(1, max_darts + 1):
         lines = dart_lines(result, k, limit)
-        longest = _longest_reach(result, lines, _TIP_GAP * h)
-        tried = None if longest is None else _attempt(result, lines, longest, held, options)
+        longest = _longest_share(result, lines, gap)
+        reach = np.array([line.reach for line in lines])
+        tried = None if longest is None else _attempt(result, lines, longest * reach, held, options)
+        tries.append((k, np.nan, np.inf if tried is None else float(tried[0])))
         if tried is None:
             continue
         if tried[0] > limit:
-            best = min(best, tried, key=lambda t: t[0])
+            best = min(best, tried[:3], key=lambda t: t[0])
             continue
-        for _, flat, darts in _shortest(result, lines, longest, tried, limit, held, options):
-            sewn = _sewn(flat, darts, held, options)  # shortest darts first: the first whose sewn legs keep it
-            if _kept(sewn) and worst_strain(sewn) <= limit:
-                return sewn, darts
-    _, flat, darts = best
-    if not darts:
-        return result, ()
-    sewn = _sewn(flat, darts, held, options)
-    return (sewn, darts) if _kept(sewn) else (flat, darts)
+        passing = [(longest, tried)]
+        lo, hi = 0.0, longest
+        for _ in range(_BISECTIONS + 2):
+            mid = 0.5 * (lo + hi)
+            again = _attempt(result, lines, mid * reach, held, options)
+            tries.append((k, np.nan, np.inf if again is None else float(again[0])))
+            if again is not None and again[0] <= limit:
+                passing.append((mid, again))
+                hi = mid
+            else:
+                lo = mid
+        passing.sort(key=lambda item: item[0])
+        found = _first_sewn([(t[1], t[2]) for _, t in passing], limit, held, options)
+        if found is not None:
+            return found, best
+    return None, best
+
+
+def _longest_share(result, lines, gap) -> float | None:
+    """The largest share of their reach the lines can all run to, tips ``gap`` apart and off the far
+    outline (bisection), or None."""
+    if not lines:
+        return None
+    reach = np.array([line.reach for line in lines])
+
+    def valid(share):
+        return (share * reach >= gap).all() and ((1 - share) * reach >= gap).all() and _valid_lengths(
+            result, lines, share * reach, gap)
+
+    lo, hi = 2.0 * gap / max(reach.min(), 1e-300), 1.0
+    if lo >= hi or not valid(lo):
+        return None
+    for _ in range(20):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if valid(mid) else (lo, mid)
+    return lo
+
+
+class _Plan:
+    """The dartless layout's geometry the dart search works from.
+
+    * ``crown``: where the darts point to, the centroid of the surface's
+      positive Gaussian curvature (angle defects) on the dartless layout;
+    * ``core``: the radius about it within which the uncut surface's
+      curvature alone would strain it by half the limit: dart tips start on
+      that circle (a dart stops where the curvature it relieves stops);
+    * each try cuts ``k`` dart lines (:func:`dart_lines`) from the outline
+      to the circle of radius ``core``, and flattens.
+    """
+
+    def __init__(self, result: Flattening, limit: float, held, options: dict):
+        self.result, self.limit, self.held, self.options = result, limit, held, options
+        uv, faces = result.uv, result.faces
+        self.gap = _TIP_GAP * float(np.mean(edge_lengths(uv, unique_edges(faces))))
+        defect = angle_defects(result.vertices, faces, loops=result.loops)
+        positive = np.maximum(defect, 0.0)
+        self.crown = (positive @ uv / positive.sum()) if positive.sum() > 0 else uv.mean(axis=0)
+        radius = np.linalg.norm(uv - self.crown, axis=1)
+        order = np.argsort(radius)
+        within = np.cumsum(positive[order])
+        # A cap of total curvature W flattens at about 1.5 W / (8 pi) strain (a hemisphere: 38.7 %):
+        # the core holds curvature for half the limit.
+        allowed = 0.5 * limit * 8.0 * np.pi / 1.5
+        inside = np.searchsorted(within, allowed, side="right")
+        outline = np.concatenate([np.asarray(loop) for loop in result.loops])
+        self.outer = float(np.linalg.norm(uv[outline] - self.crown, axis=1).min())
+        self.core = float(min(radius[order[min(inside, len(order) - 1)]], self.outer - 2 * self.gap))
+        self.core = max(self.core, self.gap)
+        self.radius, self.positive = radius, positive
+
+    def min_core(self, k: int) -> float:
+        """The smallest core radius at which ``k`` tips on its circle stay ``gap`` apart."""
+        return max(self.gap, k * self.gap / (2 * np.pi))
+
+    def first_count(self, max_darts: int) -> int:
+        """The darts a gore-width estimate asks for, outside the core (fewer tried if they pass)."""
+        r = self.radius
+        outside = r > self.core
+        if not outside.any():
+            return 1
+        # A gore of half-width w on curvature K strains about w^2 K / 4 (docs/garments.md); k darts round
+        # a circle of radius r leave gores of half-width pi r / k.  Curvature per vertex spread over
+        # its share of the area; flat radii overstate the parallels' by up to pi / 2.
+        density = self.positive / np.maximum(self._vertex_area(), 1e-300)
+        need = (2.0 / np.pi) * np.pi * r * np.sqrt(density / self.limit) / 2.0
+        need = np.sort(need[outside])[int(0.95 * outside.sum())]  # not one noisy vertex
+        return int(np.clip(np.ceil(need), 1, max_darts))
+
+    def _vertex_area(self):
+        v, f = self.result.vertices, self.result.faces
+        a = 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+        return np.bincount(f.ravel(), weights=np.repeat(a / 3.0, 3), minlength=len(v))
+
+    def lengths(self, k: int, core: float, points=()):
+        """The lengths of :func:`dart_lines` ``k``: each from the outline to the circle of radius ``core``
+        about the crown (or to the point nearest it, for a line that passes outside the circle), the
+        dart passing nearest each of ``points`` (flat, dartless layout) run on a tip gap past it.  Where
+        tips would crowd, the circle is widened until they do not (by a quarter, at most six times);
+        None if they still do."""
+        lines = dart_lines(self.result, k, self.limit)
+        uv = self.result.uv
+        starts = np.array([uv[line.start] for line in lines])
+        directions = np.array([line.direction for line in lines])
+        reach = np.array([line.reach for line in lines]) - self.gap
+        to = self.crown - starts
+        along = np.einsum("ij,ij->i", to, directions)
+        miss2 = np.einsum("ij,ij->i", to, to) - along ** 2
+        for _ in range(7):
+            lengths = np.where(miss2 < core ** 2, along - np.sqrt(np.maximum(core ** 2 - miss2, 0.0)), along)
+            for point in points:
+                rel = point - starts
+                ahead = np.einsum("ij,ij->i", rel, directions)
+                off = np.abs(rel[:, 0] * directions[:, 1] - rel[:, 1] * directions[:, 0])
+                off[ahead <= 0] = np.inf
+                i = int(np.argmin(off))
+                lengths[i] = max(lengths[i], ahead[i] + self.gap)
+            lengths = np.minimum(lengths, reach)
+            if (lengths >= self.gap).all() and _valid_lengths(self.result, lines, lengths, self.gap):
+                return lengths
+            core *= 1.25
+        return None
+
+    def attempt(self, k: int, core: float, points=()):
+        """Cut ``k`` darts (:meth:`lengths`) and flatten: ``(worst, Flattening, darts, dartless uv)`` or None."""
+        lengths = self.lengths(k, core, points)
+        if lengths is None:
+            return None
+        return _attempt(self.result, dart_lines(self.result, k, self.limit), lengths, self.held, self.options)
+
+    def worst_point(self, tried) -> np.ndarray:
+        """(2,) float64: where the worst triangle of a try lies on the dartless layout, mm."""
+        flat, uv0 = tried[1], tried[3]
+        i = int(np.argmax(triangle_strains(flat.vertices, flat.faces, flat.uv).magnitude))
+        return uv0[flat.faces[i]].mean(axis=0)
+
+    def strained_at_tips(self, tried, core: float) -> bool:
+        """Most of the area above the limit lies within reach of the dart tips (inside the core's circle
+        and a tip gap round it), rather than between the darts."""
+        flat, uv0 = tried[1], tried[3]
+        strains = triangle_strains(flat.vertices, flat.faces, flat.uv)
+        over = strains.magnitude > self.limit
+        if not over.any():
+            return False
+        centre = uv0[flat.faces[over]].mean(axis=1)
+        near = np.linalg.norm(centre - self.crown, axis=1) < core + 2.0 * self.gap
+        w = strains.area_3d[over]
+        return float(w[near].sum()) > 0.5 * float(w.sum())
 
 
 def dart_lines(result: Flattening, k: int, limit: float, *, split: bool = False) -> list:
@@ -232,16 +489,11 @@ def _reach(polygon, point, direction) -> float:
     return float(np.linalg.norm(points - point, axis=1).min())
 
 
-def _tips(result, lines, fraction) -> np.ndarray:
-    return np.array([result.uv[line.start] + fraction * line.reach * line.direction for line in lines])
-
-
-def _valid(result, lines, fraction, gap) -> bool:
-    """The dart lines at ``fraction`` of their reach stay apart: no crossing, tips ``gap`` apart and off the outline."""
-    tips = _tips(result, lines, fraction)
-    if any(fraction * line.reach < gap or (1 - fraction) * line.reach < gap for line in lines):
-        return False
-    segments = shapely.linestrings([[result.uv[line.start], tip] for line, tip in zip(lines, tips)])
+def _valid_lengths(result, lines, lengths, gap) -> bool:
+    """Dart lines of these lengths stay apart: no crossing, tips ``gap`` apart."""
+    uv = result.uv
+    tips = np.array([uv[line.start] + t * line.direction for line, t in zip(lines, lengths)])
+    segments = shapely.linestrings([[uv[line.start], tip] for line, tip in zip(lines, tips)])
     buffered = shapely.buffer(segments, 0.5 * gap)
     for i in range(len(lines)):
         for j in range(i + 1, len(lines)):
@@ -250,25 +502,12 @@ def _valid(result, lines, fraction, gap) -> bool:
     return True
 
 
-def _longest_reach(result, lines, gap) -> float | None:
-    """The largest share of their reach the lines can run to (bisection on :func:`_valid`), or None."""
-    if not lines:
-        return None
-    lo, hi = 2.0 * gap / max(min(line.reach for line in lines), 1e-300), 1.0
-    if lo >= hi or not _valid(result, lines, lo, gap):
-        return None
-    for _ in range(20):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if _valid(result, lines, mid, gap) else (lo, mid)
-    return lo
-
-
-def _attempt(result, lines, fraction, held, options):
-    """Cut the lines at ``fraction`` of their reach and flatten: ``(worst strain, Flattening, darts)`` or None."""
+def _attempt(result, lines, lengths, held, options):
+    """Cut the lines to these lengths and flatten: ``(worst strain, Flattening, darts, dartless uv)`` or None."""
     v, f, uv = result.vertices, result.faces, result.uv
     paths = []
-    for line, tip in zip(lines, _tips(result, lines, fraction)):
-        inserted = insert_line(v, f, uv, uv[line.start], tip)
+    for line, t in zip(lines, lengths):
+        inserted = insert_line(v, f, uv, uv[line.start], uv[line.start] + t * line.direction)
         v, f, uv, path = inserted.vertices, inserted.faces, inserted.uv, inserted.path
         if len(path) < 2 or path[0] != line.start:
             return None
@@ -280,25 +519,7 @@ def _attempt(result, lines, fraction, held, options):
         return None  # the seams could not be held with these darts (a flap pinned between dart and seam)
     darts = tuple(Dart(tuple(np.asarray(side, dtype=np.int64) for side in sides), polyline_length(v[path]))
                   for sides, path in zip(cut.sides, paths))
-    return worst_strain(flat), flat, darts
-
-
-def _shortest(result, lines, longest, found, limit, held, options) -> list:
-    """Shorten all darts together (bisection on their share of the reach) while the limit holds.
-
-    Returns every try that met the limit, the shortest darts first.
-    """
-    passing = [(longest, found)]
-    lo, hi = 0.0, longest
-    for _ in range(_BISECTIONS):
-        mid = 0.5 * (lo + hi)
-        tried = _attempt(result, lines, mid, held, options)
-        if tried is not None and tried[0] <= limit:
-            passing.append((mid, tried))
-            hi = mid
-        else:
-            lo = mid
-    return [tried for _, tried in sorted(passing, key=lambda item: item[0])]
+    return worst_strain(flat), flat, darts, uv[cut.source]
 
 
 def _sewn(flat: Flattening, darts: tuple, held, options) -> Flattening:

@@ -57,10 +57,11 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
         * ``ease``: :class:`~patterns.Ease` entries, deliberate extra (or less)
           length on one side of a seam;
         * ``max_strain``, ``max_darts`` (12): a freeform panel whose worst
-          triangle is above the strain gets the fewest evenly spaced darts
-          (at most ``max_darts``), each as short as the limit allows, their
-          legs sewn to equal length (:mod:`patterns.flattening.darts`); they
-          are in :attr:`FlatPanel.darts`;
+          triangle is above the strain gets evenly spaced darts (at most
+          ``max_darts``), their count and length first from the surface's
+          curvature, then measured, their legs sewn to equal length
+          (:mod:`patterns.flattening.darts`); they are in
+          :attr:`FlatPanel.darts`, the search in :attr:`FlatPanel.dart_search`;
         * ``max_iterations`` (500), ``energy_tolerance`` (1e-6; ``flatten_mesh``:
           1e-5, a pattern is relaxed to convergence), ``min_stretch``,
           ``energy`` (``"auto"``): the relaxation, see :func:`flatten_mesh`.
@@ -98,7 +99,7 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     flat, targets = [], {}
     for i, panel in enumerate(model.panels):
         name = f"{model.name}: panel {panel.name}"
-        darts = ()
+        darts, search = (), None
         if opts.exact and panel.surface is not None and i not in eased_panels:
             result = developed(panel, offset, name)
         else:
@@ -109,11 +110,11 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
             options = _engine_options(opts, name)
             result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
             if max_strain is not None and not opts.gores:
-                result, darts = cut_darts(result, max_strain, max_darts, held, options)
+                result, darts, search = cut_darts(result, max_strain, max_darts, held, options)
         targets.update(_side_targets(model, i, result, eased, mode))
         if panel.name in grains:
             result = turn_to_grain(result, grains[panel.name])
-        flat.append(FlatPanel(panel.name, panel, result, darts=darts))
+        flat.append(FlatPanel(panel.name, panel, result, darts=darts, dart_search=search))
         if progress is not None:
             progress(i + 1, len(model.panels))
     seams_out = []
