@@ -362,6 +362,11 @@ def _usable(flat, report, opts) -> list:
     return out
 
 
+DARTS_PER_GORE = 1.2
+"""Darts a dome takes for each balanced gore of the gore bound (measured: a hemisphere's 11 darts at 3 %
+against the bound's 9.07)."""
+
+
 def _dart_notes(flat, mag, uv, faces) -> list:
     """The note on a panel's darts: how many and how long, and whether they met the limit they were
     cut for; where they did not (or there was none to cut), the best strain reached and where."""
@@ -385,6 +390,17 @@ def _dart_notes(flat, mag, uv, faces) -> list:
         text = (f"panel {flat.name}: {cut}{of}; the strain limit {limit:.2%} was not met within {search.max_darts} "
                 f"darts ({tried} cuts measured): the best reached is {where}, from {search.before:.2%} "
                 f"without darts")
+        if search.needed == 0:
+            text += ("; the surface has no positive curvature for darts to take out (it is saddle-shaped): "
+                     "cut gores")
+        else:
+            text += (f"; the surface's curvature asks for about {search.needed:.1f} darts at this limit (the gore "
+                     f"bound; darts take about {DARTS_PER_GORE:g} times as many)")
+        if 0 < search.needed and DARTS_PER_GORE * search.needed > search.max_darts:
+            text += ": allow more darts, or cut gores"
+        if not search.sewn:
+            apart = max(abs(np.subtract(*d.leg_lengths(uv))) for d in flat.darts)
+            text += f"; the legs could not be held to equal lengths (up to {apart:.2f} mm apart)"
         if search.met and not search.sewn:
             text = (f"panel {flat.name}: {cut}{of} keep the strain within {limit:.2%}, but their legs could not "
                     f"be held to equal lengths with the panel's seams")

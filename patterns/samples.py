@@ -49,8 +49,10 @@ each one build123d face:
   over a quarter turn: positive curvature everywhere.
 * ``saddle`` -- a B-spline face through z = (x^2 - y^2) / 400 on a 200 mm
   square: negative curvature everywhere.
-* ``freeform_cup`` -- an asymmetric cup, one B-spline face through a 5 x 5
-  grid of points, 160 x 120 mm and 40 mm deep, its deepest point off centre.
+* ``freeform_cup`` -- an asymmetric cup, one B-spline face through a 9 x 9
+  grid of points, 160 x 120 mm and 40 mm deep, its deepest point off centre;
+  ``freeform_bag`` -- the same depth pressed into a flat sheet (a 5 x 5 grid
+  whose outer ring is flat).
 """
 
 from __future__ import annotations
@@ -59,7 +61,7 @@ from math import pi
 
 import numpy as np
 
-__all__ = ["DOMES", "SAMPLES", "bowl_segment", "cup", "duct_transition", "ellipsoid_cap", "freeform_cup", "hopper",
+__all__ = ["DOMES", "SAMPLES", "bowl_segment", "cup", "duct_transition", "ellipsoid_cap", "freeform_bag", "freeform_cup", "hopper",
            "hull_panel", "oblate_dome", "prolate_dome", "rolled_cylinder", "saddle", "sphere_gores", "spline_bowl",
            "square_to_round", "torus_patch"]
 
@@ -243,7 +245,20 @@ def saddle():
 
 
 def freeform_cup():
-    """An asymmetric cup: one B-spline face through a 5 x 5 grid, 160 x 120 mm, 40 mm deep off centre."""
+    """An asymmetric cup: one B-spline face through a 9 x 9 grid, 160 x 120 mm, 40 mm deep off centre.
+
+    Depth ``40 (1 - u^2)(1 - v^2)(1 + u / 2) / 1.5`` over ``u, v`` in [-1, 1]: deepest towards +x.
+    """
+    import build123d as bd
+
+    u = np.linspace(-1.0, 1.0, 9)
+    points = [[(80.0 * a, 60.0 * b, -40.0 * (1 - a * a) * (1 - b * b) * (1 + a / 2) / 1.5) for a in u] for b in u]
+    return bd.Face.make_surface_from_array_of_points(points)
+
+
+def freeform_bag():
+    """A bag pressed into a flat sheet: one B-spline face through a 5 x 5 grid, 160 x 120 mm, its
+    outer ring of points flat, 40 mm deep off centre (darts from its outline must cross the flat)."""
     import build123d as bd
 
     depth = [[0, 0, 0, 0, 0], [0, 14, 20, 12, 0], [0, 24, 40, 22, 0], [0, 12, 24, 10, 0], [0, 0, 0, 0, 0]]
@@ -260,6 +275,7 @@ DOMES = {
     "torus patch": torus_patch,
     "saddle": saddle,
     "freeform cup": freeform_cup,
+    "freeform bag": freeform_bag,
 }
 """The curved faces of the dart and gore benchmark, by name (each function returns one face)."""
 

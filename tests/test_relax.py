@@ -117,6 +117,10 @@ def test_pins_that_would_fold_the_pattern_stop_short_and_never_fold():
         ({"pins": ([0], [[0.0, 0.0]]), "method": "isometric"}, "method='relaxed' only"),
         ({"max_iterations": 0}, "max_iterations"),
         ({"energy_tolerance": -1.0}, "energy_tolerance"),
+        ({"start": np.zeros((3, 2))}, "start must be a finite"),
+        ({"start": np.zeros((6, 2))}, "start must be a finite"),  # shape checked before anything else
+        ({"start": "lscm"}, "start must be a finite"),
+        ({"start": np.zeros((1, 2)), "method": "isometric"}, "method='relaxed' only"),
     ],
 )
 def test_bad_options(kwargs, words):
@@ -124,6 +128,25 @@ def test_bad_options(kwargs, words):
     with pytest.raises(InputError, match=None) as info:
         patterns.flatten_mesh(v, f, **kwargs)
     assert words in str(info.value)
+
+
+def test_a_given_start_is_relaxed_from_and_a_folded_one_refused():
+    """``start=``: the relaxation goes on from the layout given (``Flattening.start`` says "given"),
+    ends where a run from the grower's layout ends (its energy to the tolerance), and from its own
+    result stops at once; a folded start is refused."""
+    v, f = surfaces.paraboloid_dish(n_faces=1500)
+    first = patterns.flatten_mesh(v, f)
+    again = patterns.flatten_mesh(v, f, start=first.uv)
+    assert again.start == "given" and again.iterations <= 3
+    np.testing.assert_allclose(again.uv, first.uv, atol=1e-3 * np.ptp(first.uv))
+    bent = first.uv * np.array([1.0, 1.3])  # one-to-one, 30 % off in one direction
+    from_bent = patterns.flatten_mesh(v, f, start=bent)
+    assert from_bent.start == "given" and from_bent.iterations > 3
+    assert from_bent.distortion.strain_rms == pytest.approx(first.distortion.strain_rms, rel=1e-2)
+    folded = first.uv.copy()
+    folded[f[0, 0]] = 2 * folded[f[0, 1:]].mean(axis=0) - folded[f[0, 0]]  # one corner over its far side
+    with pytest.raises(InputError, match="one-to-one"):
+        patterns.flatten_mesh(v, f, start=folded)
 
 
 def test_an_exact_start_stops_at_once():

@@ -28,8 +28,8 @@ __all__ = ["flatten_mesh"]
 
 def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | None = None,
                  pins=None, max_iterations: int = 500, energy_tolerance: float = 1e-5,
-                 min_stretch: float | None = None, energy: str = "auto", lengths=None, progress=None,
-                 name: str = "mesh") -> Flattening:
+                 min_stretch: float | None = None, energy: str = "auto", lengths=None, start=None,
+                 progress=None, name: str = "mesh") -> Flattening:
     """Flatten a triangle mesh to the plane at true scale.
 
     Parameters
@@ -96,6 +96,11 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         With a third array of group numbers, the edges of a group are held
         in total instead of one by one.  ``Flattening.length_error`` says how
         close they came.
+    start : (n, 2) float, optional
+        ``"relaxed"`` only: a one-to-one layout of this mesh to relax from
+        instead of the grower's (the same panel's layout before a constraint
+        was added: :mod:`patterns.flattening.darts` sews a dart's legs from
+        the layout they fell into when cut).
     progress : callable, optional
         Called as ``progress(n_done, n_total)``: vertices placed by a grower,
         then iterations of the relaxation.
@@ -120,7 +125,7 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
     # mesh is validated (a second at 1M faces).
     method = FlattenOptions.checked("method", method, where=name)
     if method != "relaxed":
-        for option, value in (("pins", pins), ("min_stretch", min_stretch), ("lengths", lengths)):
+        for option, value in (("pins", pins), ("min_stretch", min_stretch), ("lengths", lengths), ("start", start)):
             if value is not None:
                 raise InputError(f"{name}: {option} applies to method='relaxed' only")
         if energy != "auto":
@@ -139,13 +144,17 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
     if pins is not None:
         pins = check_pins(pins, len(v), name)
         pins = pins if num is None else (inv[pins[0]], pins[1])
+    if start is not None:
+        start = _check_start(start, v, f, conn, name)
+        start = start if num is None else start[num.vertex]
     wv, wf = (v, f) if num is None else (v[num.vertex], num.faces)
     seed = grow.seed_face(wv, wf, conn) if seed_face is None else int(seed_face if num is None
                                                                          else num.face_inverse[seed_face])
     with threadpool_limits(limits=1, user_api="blas"):
         # One BLAS thread: a sum split between threads rounds differently, and the
         # pattern must not depend on the machine's thread count.
-        uv, extras = _engine(wv, wf, conn, seed, method, pins, lengths, progress, name, max_iterations=max_iterations,
+        uv, extras = _engine(wv, wf, conn, seed, method, pins, lengths, progress, name, start=start,
+                             max_iterations=max_iterations,
                              tolerance=energy_tolerance, min_stretch=min_stretch, energy=energy)
     loops = conn.loops
     if num is not None:  # back to the input's numbering
@@ -186,9 +195,24 @@ def _working_mesh(vertices, faces, name):
     return v, f, num, conn
 
 
-def _engine(v, f, conn, seed, method, pins, lengths, progress, name, **relax_options):
+def _check_start(start, v, f, conn, name) -> np.ndarray:
+    """A given start layout as ``(n, 2) float64``, refused unless finite and one-to-one."""
+    try:
+        uv = np.asarray(start, dtype=np.float64)
+    except (TypeError, ValueError):
+        uv = np.zeros((0,))
+    if uv.shape != (len(v), 2) or not np.isfinite(uv).all():
+        raise InputError(f"{name}: start must be a finite ({len(v)}, 2) layout, got shape {uv.shape}")
+    if not overlap_verdict(uv, f, conn.loops).one_to_one:
+        raise InputError(f"{name}: start must be a one-to-one layout (no folded triangle, no crossing boundary)")
+    return uv
+
+
+def _engine(v, f, conn, seed, method, pins, lengths, progress, name, start=None, **relax_options):
     """Flatten the canonically numbered mesh: ``(uv (n, 2), extra Flattening fields)``."""
     z = local_coordinates(v, f)
+    if start is not None:
+        return _relaxed(v, f, conn, start, z, pins, lengths, progress, label="given", **relax_options)
     weights = 0.5 * np.abs((np.conj(z[:, 1]) * z[:, 2]).imag)
     with np.errstate(over="ignore", invalid="ignore"):
         if method == "conformal":
@@ -212,15 +236,15 @@ def _engine(v, f, conn, seed, method, pins, lengths, progress, name, **relax_opt
     return uv, {}
 
 
-def _relaxed(v, f, conn, greedy, z, pins, lengths, progress, **options):
+def _relaxed(v, f, conn, greedy, z, pins, lengths, progress, label="greedy", **options):
     """Pick a one-to-one start (greedy, else LSCM, else Tutte) and relax it: ``(uv, extra Flattening fields)``.
 
     The relaxation runs on the mesh renumbered in a nested-dissection order of
     the start (:mod:`patterns.flattening.numbering`): its time does not depend
     on the input's numbering, nor on the part's placement in space.
     """
-    start, label, barrier = greedy, "greedy", 0.0
-    if not overlap_verdict(start, f, conn.loops).one_to_one:
+    start, barrier = greedy, 0.0
+    if label == "greedy" and not overlap_verdict(start, f, conn.loops).one_to_one:
         start, label = lscm(v, f, conn, local=z), "lscm"
         if not overlap_verdict(start, f, conn.loops).one_to_one:
             start, label = tutte_embedding(v, f, conn), "tutte"
