@@ -17,8 +17,9 @@ a single-panel flattening with no limit; there is no open dart tool to race).
 
 Then (``--shapes``, issue 36) the curved faces of ``patterns.samples.DOMES``
 (a spline bowl, oblate and prolate domes, an ellipsoid, a torus patch, a
-saddle, an asymmetric freeform cup), each with darts and then in gores: the
-worst and RMS strain, the darts' total 3D length or the gore count, whether the
+saddle, an asymmetric freeform cup), each with darts (inserts on the saddle)
+and then in gores: the worst and RMS strain, the darts' total 3D length or the
+gore count, whether the
 limit was met, the largest difference between the two flat sides of a gore
 seam, and the time against the dartless flattening.
 
@@ -42,7 +43,8 @@ import bench_flatten as bench  # libigl's ARAP, as the flattening benchmark runs
 import patterns
 from patterns import samples, surfaces
 from patterns.flattening.curvature import gore_bound as curvature_bound
-from patterns.measure import strain_rms, triangle_strains
+from patterns.flattening.inserts import is_saddle
+from patterns.measure import angle_defects, strain_rms, triangle_strains
 from patterns.reading import mesh_model
 
 REPO = Path(__file__).resolve().parent.parent
@@ -108,6 +110,14 @@ def worst_of(pattern) -> float:
     return max(float(triangle_strains(p.vertices, p.faces, p.uv).magnitude.max()) for p in pattern.panels)
 
 
+def _bound(result, limit: float) -> str:
+    """The gore bound of a panel's positive curvature, or of its negative curvature on a saddle (slashes)."""
+    if is_saddle(result.vertices, result.faces, result.loops):
+        negative = -angle_defects(result.vertices, result.faces, loops=result.loops)
+        return f"{curvature_bound(result, limit, defects=negative):.1f} (saddle)"
+    return f"{curvature_bound(result, limit):.1f}"
+
+
 def shapes(limit: float) -> int:
     """The table of docs/garments.md "On other curved shapes"."""
     print("| shape | triangles | worst, no darts | gore bound | darts | worst | RMS | dart length | met | time "
@@ -119,9 +129,10 @@ def shapes(limit: float) -> int:
         darted, t_darts = timed(partial(patterns.flatten, model, max_strain=limit))
         gored, t_gores = timed(partial(patterns.flatten, model, max_strain=limit, gores=True))
         darts = [d for p in darted.panels for d in p.darts]
+        inserts = sum(p.panel.insert_into is not None for p in darted.panels)
         rms = max(strain_rms(p.vertices, p.faces, p.uv) for p in darted.panels)
         after, in_gores = worst_of(darted), worst_of(gored)
-        bound = max(curvature_bound(p.flattening, limit) for p in plain.panels)
+        bound = max(_bound(p.flattening, limit) for p in plain.panels)
         more = "-"
         if after > limit:  # how many darts it takes where 12 are too few
             many, t_many = timed(partial(patterns.flatten, model, max_strain=limit, max_darts=24))
@@ -130,7 +141,8 @@ def shapes(limit: float) -> int:
         new = gored.seams[len(model.seams):]
         sides = max((abs(fs.flat_lengths[0] - fs.flat_lengths[1]) for fs in new), default=0.0)
         n = sum(len(p.faces) for p in model.panels)
-        print(f"| {name} | {n:,} | {worst_of(plain):.1%} | {bound:.1f} | {len(darts)} | {after:.2%} | {rms:.2%} "
+        cuts = f"{inserts} insert{'' if inserts == 1 else 's'}" if inserts else f"{len(darts)}"
+        print(f"| {name} | {n:,} | {worst_of(plain):.1%} | {bound} | {cuts} | {after:.2%} | {rms:.2%} "
               f"| {sum(d.length_3d for d in darts):,.0f} mm | {'yes' if after <= limit else 'no'} | {t_darts:.1f} s "
               f"| {t_darts / t_plain:.0f} x | {more} | {len(gored.panels)} | {in_gores:.2%} | {sides:.3f} mm "
               f"| {'yes' if in_gores <= limit else 'no'} | {t_gores:.1f} s |", flush=True)

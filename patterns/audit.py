@@ -276,7 +276,7 @@ def _check_pattern(pattern: Pattern, opts: CheckOptions) -> Report:
         report, found = _panel_report(flat, max_strain)
         panel_reports.append(report)
         findings += found + _usable(flat, report, opts)
-    findings += _overlaps_between(pattern)
+    findings += _overlaps_between(pattern) + _insert_notes(pattern, max_strain)
     seam_reports = []
     for fs in pattern.seams:
         report, found = _seam_report(pattern, fs, max_seam_mismatch)
@@ -392,7 +392,7 @@ def _dart_notes(flat, mag, uv, faces) -> list:
                 f"without darts")
         if search.needed == 0:
             text += ("; the surface has no positive curvature for darts to take out (it is saddle-shaped): "
-                     "cut gores")
+                     "allow more slashes with inserts (max_darts), or cut gores")
         else:
             text += (f"; the surface's curvature asks for about {search.needed:.1f} darts at this limit (the gore "
                      f"bound; darts take about {DARTS_PER_GORE:g} times as many)")
@@ -405,6 +405,30 @@ def _dart_notes(flat, mag, uv, faces) -> list:
             text = (f"panel {flat.name}: {cut}{of} keep the strain within {limit:.2%}, but their legs could not "
                     f"be held to equal lengths with the panel's seams")
     return [Finding(Code.DARTS, Severity.NOTE, (flat.name,), tips, (), None, text)]
+
+
+def _insert_notes(pattern, max_strain) -> list:
+    """The note on each slashed panel: its inserts, the tips of the slashes they fill (points), and whether
+    every piece met the strain limit they were cut for."""
+    index = {flat.name: i for i, flat in enumerate(pattern.panels)}
+    out = []
+    for name in dict.fromkeys(f.panel.insert_into for f in pattern.panels if f.panel.insert_into is not None):
+        main = index[name]
+        inserts = [f.name for f in pattern.panels if f.panel.insert_into == name]
+        tips = {int(fs.seam.vertices[fs.seam.panels.index(main)][-1]) for fs in pattern.seams
+                if main in fs.seam.panels and pattern.panels[sum(fs.seam.panels) - main].panel.insert_into == name}
+        uv = pattern.panels[main].uv
+        text = (f"panel {name}: saddle-shaped (its curvature is negative), so slashed "
+                f"{counted(len(inserts), 'time')} from its outline; each slash opens into a wedge that "
+                f"an insert fills ({', '.join(inserts)}), sewn along its 3D length")
+        pieces = [pattern.panels[index[p]] for p in (name, *inserts)]
+        worst = [float(p.strains.magnitude.max()) for p in pieces]
+        if max_strain is not None and max(worst) > max_strain:
+            at = int(np.argmax(worst))
+            text += (f"; the strain limit {max_strain:.2%} was not met: the worst piece reaches {worst[at]:.2%} "
+                     f"(panel {pieces[at].name}): allow more slashes (max_darts), or cut gores")
+        out.append(Finding(Code.INSERTS, Severity.NOTE, (name, *inserts), uv[sorted(tips)], (), None, text))
+    return out
 
 
 SEAM_LENGTH_TOLERANCE = 1e-3

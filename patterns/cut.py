@@ -473,8 +473,11 @@ def insert_line(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, start, 
     on_line = (off < snap * mean_len) & (t_vertex >= 0) & (t_vertex <= 1)
     if keep_off is not None:
         on_line[np.asarray(keep_off, dtype=np.int64)] = False
-    on_line |= np.linalg.norm(rel, axis=1) == 0.0  # the start itself, when it is a vertex
-    on_line |= np.linalg.norm(uv - (a + d), axis=1) == 0.0  # and the end
+    # The start and the end themselves, when they are vertices: to round-off (``a + d`` may miss the end's
+    # vertex in the last bit, which would then be crossed through its own edges).
+    at_end = 1e-12 * np.sqrt(length2)
+    on_line |= np.linalg.norm(rel, axis=1) <= at_end
+    on_line |= np.linalg.norm(uv - np.asarray(end, dtype=np.float64), axis=1) <= at_end
     p, e = uv[edges[:, 0]], uv[edges[:, 1]] - uv[edges[:, 0]]
     denom = d[0] * e[:, 1] - d[1] * e[:, 0]
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -94,6 +94,10 @@ class Panel:
     param : (n, 2) float64 or None
         With ``surface``: each vertex's surface parameters (u, v), to tell the
         two copies of a point on a seam line apart (approximate on the boundary).
+    insert_into : str or None
+        For an insert (:mod:`patterns.flattening.inserts`: a wedge cut from a
+        saddle-shaped panel to relieve it, sewn back into the slash it leaves):
+        the name of the panel it fills.
     """
 
     name: str
@@ -103,6 +107,7 @@ class Panel:
     cad_faces: tuple = ()
     surface: Surface | None = None
     param: np.ndarray | None = None
+    insert_into: str | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "vertices", _own(self.vertices))
@@ -233,10 +238,11 @@ class Model:
 
 
 def panel_from_mesh(label: str, vertices, faces, *, name: str, cad_faces: tuple = (), surface=None,
-                    param=None) -> Panel:
+                    param=None, insert_into: str | None = None) -> Panel:
     """A :class:`Panel` from a disk-like mesh: validated (``name`` in messages), its loops longest first.
 
     The one way loading builds a panel, from a mesh file's piece or from CAD faces.
     """
     v, f, conn = validate_mesh(vertices, faces, name=name)
-    return Panel(label, v, f, longest_first(v, conn.loops), tuple(cad_faces), surface=surface, param=param)
+    return Panel(label, v, f, longest_first(v, conn.loops), tuple(cad_faces), surface=surface, param=param,
+                 insert_into=insert_into)

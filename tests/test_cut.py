@@ -181,3 +181,23 @@ def test_a_can_splits_into_caps_and_side_with_closed_rims():
     for _, _, path in chains:
         assert path[0] == path[-1] and len(path) == 33  # closed: 32 edges, the first vertex again
         assert np.ptp(v[path, 2]) == pytest.approx(0.0, abs=1e-9)  # each rim in one plane
+
+
+def test_a_line_ending_on_a_vertex_ends_there_whatever_the_last_bit_of_the_sum():
+    """A line drawn to a vertex ends on that vertex and crosses none of its edges, even where
+    ``start + (end - start)`` misses ``end`` in the last bit and the vertex measures a hair past the end
+    (a crossing at the vertex itself would put a point there twice, and two triangles of no area).
+    The two points are those of a slash of :mod:`patterns.flattening.inserts` on the saddle that ended so."""
+    from patterns.cut import insert_line
+    from patterns.mesh import face_areas
+
+    v, f = _grid(60, 240.0)  # a grid of 7,200 triangles, 4 mm cells, about (0, 0)
+    v[:, :2] -= 120.0
+    start = np.array([float.fromhex("-0x1.7ce7383e4bdf9p+4"), float.fromhex("0x1.a65b141235783p+6")])
+    end = np.array([float.fromhex("-0x1.6095e63722d77p-1"), float.fromhex("0x1.5d56b396e6258p+4")])
+    assert np.any(start + (end - start) != end)
+    tip = int(np.argmin(np.linalg.norm(v[:, :2] - end, axis=1)))
+    v[tip, :2] = end
+    out = insert_line(v, f, v[:, :2], start, end)
+    assert out.path[-1] == tip
+    assert face_areas(out.vertices, out.faces).min() > 1e-3 * 16.0

@@ -369,6 +369,7 @@ class _Plan:
         self.core = float(min(radius[order[min(inside, len(order) - 1)]], self.outer - 2 * self.gap))
         self.core = max(self.core, self.gap)
         self.bound = gore_bound(result, limit, defects=defect, crown=self.crown)
+        self._lines = {}
 
     def min_core(self, k: int) -> float:
         """The smallest core radius at which ``k`` tips on its circle stay ``gap`` apart."""
@@ -378,13 +379,19 @@ class _Plan:
         """The count the search starts from: the gore bound rounded up, within 1 and ``max_darts``."""
         return int(np.clip(np.ceil(self.bound), 1, max_darts))
 
+    def lines(self, k: int) -> list:
+        """:func:`dart_lines` of ``k`` darts on the dartless layout (made once per count)."""
+        if k not in self._lines:
+            self._lines[k] = dart_lines(self.result, k, self.limit)
+        return self._lines[k]
+
     def lengths(self, step: _Step):
         """The lengths of the ``step.k`` lines of :func:`dart_lines`: each from the outline to the circle
         of radius ``step.core`` about the crown (or to the point nearest the crown, for a line that
         passes outside the circle), every other one ``step.deep`` further, the dart passing nearest
         each of ``step.points`` run on a tip gap past it.  Where tips would crowd, the circle is widened
         until they do not (by a quarter, at most six times); None if they still do."""
-        lines = dart_lines(self.result, step.k, self.limit)
+        lines = self.lines(step.k)
         uv = self.result.uv
         starts = np.array([uv[line.start] for line in lines])
         directions = np.array([line.direction for line in lines])
@@ -416,19 +423,18 @@ class _Plan:
         lengths = self.lengths(step)
         if lengths is None:
             return None
-        return _attempt(self.result, dart_lines(self.result, step.k, self.limit), lengths, self.held, self.options)
+        return _attempt(self.result, self.lines(step.k), lengths, self.held, self.options)
 
     def worst_point(self, tried) -> np.ndarray:
         """(2,) float64: where the worst triangle of a try lies on the dartless layout, mm."""
         flat, uv0 = tried[1], tried[3]
-        i = int(np.argmax(triangle_strains(flat.vertices, flat.faces, flat.uv).magnitude))
+        i = int(np.argmax(tried[4].magnitude))
         return uv0[flat.faces[i]].mean(axis=0)
 
     def strained_at_tips(self, tried, core: float) -> bool:
         """Most of the area above the limit lies within reach of the dart tips (inside the core's circle
         and a tip gap round it), rather than between the darts."""
-        flat, uv0 = tried[1], tried[3]
-        strains = triangle_strains(flat.vertices, flat.faces, flat.uv)
+        flat, uv0, strains = tried[1], tried[3], tried[4]
         over = strains.magnitude > self.limit
         if not over.any():
             return False
@@ -562,7 +568,8 @@ def _valid_lengths(result, lines, lengths, gap) -> bool:
 
 
 def _attempt(result, lines, lengths, held, options):
-    """Cut the lines to these lengths and flatten: ``(worst strain, Flattening, darts, dartless uv)`` or None."""
+    """Cut the lines to these lengths and flatten: ``(worst strain, Flattening, darts, dartless uv, its
+    TriangleStrain)`` or None."""
     v, f, uv = result.vertices, result.faces, result.uv
     paths = []
     for line, t in zip(lines, lengths):
@@ -578,7 +585,8 @@ def _attempt(result, lines, lengths, held, options):
         return None  # the seams could not be held with these darts (a flap pinned between dart and seam)
     darts = tuple(Dart(tuple(np.asarray(side, dtype=np.int64) for side in sides), polyline_length(v[path]))
                   for sides, path in zip(cut.sides, paths))
-    return worst_strain(flat), flat, darts, uv[cut.source]
+    strains = triangle_strains(flat.vertices, flat.faces, flat.uv)
+    return float(strains.magnitude.max()), flat, darts, uv[cut.source], strains
 
 
 def _sewn(flat: Flattening, darts: tuple, held, options) -> Flattening:

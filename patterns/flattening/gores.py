@@ -24,7 +24,7 @@ from .darts import dart_lines, worst_strain
 from .engine import flatten_mesh
 from .seams import held_lengths
 
-__all__ = ["gored", "split_panel"]
+__all__ = ["flat_piece", "gored", "split_panel"]
 
 
 def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, options: dict) -> Model:
@@ -64,7 +64,7 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
         if split is None:
             continue
         n_pieces = len(split.panels) - len(model.panels) + 1
-        worst = max(worst_strain(_flat_piece(split, p, options)) for p in range(index, index + n_pieces))
+        worst = max(worst_strain(flat_piece(split, p, options)) for p in range(index, index + n_pieces))
         if worst < best[0]:
             best = (worst, split)
         if worst <= limit:
@@ -72,7 +72,7 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
     return best[1]
 
 
-def split_panel(model: Model, index: int, paths) -> Model | None:
+def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Model | None:
     """Cut panel ``index`` along ``paths`` (vertex paths joined by its edges, after :func:`insert_line`) into pieces.
 
     ``paths`` are given on the panel mesh with the lines already put in
@@ -80,7 +80,9 @@ def split_panel(model: Model, index: int, paths) -> Model | None:
     place (named ``name-1``, ``name-2``, ...; panels after it move up), every
     cut becomes a seam between the two pieces it parts (appended after the
     model's seams, so seam ids stay), and the panel's seams move to the piece
-    they lie on.  None if the cuts do not part the panel into one piece more
+    they lie on.  With ``inserts``, the largest piece keeps the panel's name
+    and comes first, the others are its inserts (``name-insert-1``, ...,
+    :attr:`Panel.insert_into` the panel's name).  None if the cuts do not part the panel into one piece more
     than there are cuts meeting at one point (a cut that parts nothing).
     """
     vertices, faces, cuts = paths
@@ -89,6 +91,12 @@ def split_panel(model: Model, index: int, paths) -> Model | None:
     groups = pieces(cut.faces, len(cut.vertices), name=panel.name)
     if len(groups) < 2:
         return None
+    labels = [f"{panel.name}-{j + 1}" for j in range(len(groups))]
+    into = [None] * len(groups)
+    if inserts:
+        groups.sort(key=len, reverse=True)
+        labels = [panel.name] + [f"{panel.name}-insert-{j}" for j in range(1, len(groups))]
+        into = [None] + [panel.name] * (len(groups) - 1)
     parts, local = [], np.full(len(cut.vertices), -1, dtype=np.int64)
     owner = np.full(len(cut.vertices), -1, dtype=np.int64)
     for j, group in enumerate(groups):
@@ -96,8 +104,8 @@ def split_panel(model: Model, index: int, paths) -> Model | None:
         used = np.unique(f)
         local[used] = np.arange(len(used))
         owner[used] = j
-        parts.append(panel_from_mesh(f"{panel.name}-{j + 1}", cut.vertices[used], np.searchsorted(used, f),
-                                      name=f"{model.name}: panel {panel.name}-{j + 1}"))
+        parts.append(panel_from_mesh(labels[j], cut.vertices[used], np.searchsorted(used, f),
+                                      name=f"{model.name}: panel {labels[j]}", insert_into=into[j]))
     k = len(groups)
     renumber = np.array([p if p < index else p + k - 1 for p in range(len(model.panels))])
     seams = []
@@ -166,7 +174,8 @@ def _gore_paths(result: Flattening, k: int, limit: float):
     return v, f, paths
 
 
-def _flat_piece(model: Model, p: int, options: dict) -> Flattening:
+def flat_piece(model: Model, p: int, options: dict) -> Flattening:
+    """Panel ``p`` of ``model`` flattened with its seams held (``options``: keywords of :func:`flatten_mesh`)."""
     panel = model.panels[p]
     held = held_lengths(model, p, panel.vertices, {}, mesh_edges=unique_edges(panel.faces))
     return flatten_mesh(panel.vertices, panel.faces, lengths=held, **options)

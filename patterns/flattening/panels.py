@@ -20,6 +20,7 @@ from .develop import developed, neutral_offset, offset_along_normals
 from .engine import flatten_mesh
 from .gores import gored
 from .grain import grain_table, turn_to_grain
+from .inserts import is_saddle, slashed
 from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
 from .settings import FlattenOptions
 
@@ -89,14 +90,16 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     offset = neutral_offset(opts.thickness, opts.k_factor, opts.reference, name=model.name)
     grain_table(opts.grain, model)  # bad grain or ease refused before any long work
     eased = validate_ease(opts.ease, model)
-    if max_strain is not None and opts.gores:
+    if max_strain is not None:
         keep = {model.seams[s].panels[side] for s, side in eased}  # an eased seam's panel keeps its name
-        model = _split_into_gores(model, opts, offset, keep)
+        model = _split(model, opts, offset, keep)
         eased = validate_ease(opts.ease, model)
     grains = grain_table(opts.grain, model)
     mode = SeamLengths(opts.seams)
     eased_panels = {model.seams[s].panels[side] for s, side in eased}
     flat, targets = [], {}
+    slashed = {p.insert_into for p in model.panels if p.insert_into is not None}  # no darts on these, nor inserts
+    slashed |= {p.name for p in model.panels if p.insert_into is not None}
     for i, panel in enumerate(model.panels):
         name = f"{model.name}: panel {panel.name}"
         darts, search = (), None
@@ -109,7 +112,7 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
                 held = held_lengths(model, i, vertices, eased, mode, mesh_edges=unique_edges(panel.faces))
             options = _engine_options(opts, name)
             result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
-            if max_strain is not None and not opts.gores:
+            if max_strain is not None and not opts.gores and panel.name not in slashed:
                 result, darts, search = cut_darts(result, max_strain, max_darts, held, options)
         targets.update(_side_targets(model, i, result, eased, mode))
         if panel.name in grains:
@@ -134,8 +137,9 @@ def _engine_options(opts: FlattenOptions, name: str) -> dict:
             "min_stretch": opts.min_stretch, "energy": opts.energy, "name": name}
 
 
-def _split_into_gores(model: Model, opts: FlattenOptions, offset: float, keep: set) -> Model:
-    """``gores=True``: every freeform panel above the strain limit split into gores (:mod:`.gores`).
+def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> Model:
+    """``max_strain``: every freeform panel above the limit split into gores (``gores=True``, :mod:`.gores`),
+    or, if saddle-shaped, slashed and given inserts (:mod:`.inserts`; other panels get darts later).
 
     Panels are taken last to first, so that a split does not move the
     panels still to be looked at.
@@ -144,12 +148,15 @@ def _split_into_gores(model: Model, opts: FlattenOptions, offset: float, keep: s
         panel = model.panels[i]
         if (opts.exact and panel.surface is not None) or opts.method != "relaxed" or i in keep:
             continue
+        if not opts.gores and not is_saddle(panel.vertices, panel.faces, panel.loops):
+            continue
         name = f"{model.name}: panel {panel.name}"
         vertices = offset_along_normals(panel, offset) if offset else panel.vertices
         held = held_lengths(model, i, vertices, {}, SeamLengths(opts.seams), mesh_edges=unique_edges(panel.faces))
         options = _engine_options(opts, name)
         result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
-        model = gored(model, i, result, opts.max_strain, opts.max_darts, options)
+        cut = gored if opts.gores else slashed
+        model = cut(model, i, result, opts.max_strain, opts.max_darts, options)
     return model
 
 
