@@ -13,6 +13,9 @@ Meshes
   root (up to ``--max-corpus-faces`` faces), loaded with
   ``trimesh.load(path, process=False)`` (skipped, with the reason printed, when
   the folder is absent or ``--no-corpus`` is given);
+* the same of ``../shared/corpus_limbs/`` (:data:`LIMBS`, issue 37): OptCuts' benchmark
+  inputs with long thin limbs (two hands, an armadillo, a dinosaur, a torso with arms),
+  their provenance in that folder's README.md;
 * generated surfaces at about 1k, 10k, 100k and 1M faces (``--sizes``): a 60
   degree spherical cap (``cap60``: radius 100 mm, polar half-angle 30 degrees), a
   paraboloid dish, a saddle and a half cylinder (exactly developable); and at
@@ -41,8 +44,11 @@ Methods (``--methods``; default all but ``conformal``)
   ``igl.ARAPData`` (10 iterations), one vertex held at its initial position (the
   translation only).  The time includes the harmonic initialisation.
 * ``slim``: ``igl.slim_precompute`` / ``igl.slim_solve``, symmetric Dirichlet,
-  no constraints, :data:`SLIM_ITERATIONS` iterations, from the same harmonic
-  initialisation (included in the time); up to ``--max-faces-slim`` faces.
+  no constraints, :data:`SLIM_ITERATIONS` iterations, from Tutte's embedding
+  (uniform weights, the boundary on the circle: one-to-one, as SLIM needs; the
+  harmonic map folds the OptCuts armadillo and dinosaur), included in the time;
+  up to ``--max-faces-slim`` faces.  (Until issue 37 SLIM started from the
+  harmonic map; the tables of docs/benchmarks.md say which.)
 
 Every row is measured by the same code outside the timed region:
 :func:`patterns.distortion` (area-weighted principal-strain RMS and max,
@@ -90,6 +96,8 @@ from importlib import metadata
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
@@ -104,6 +112,10 @@ from patterns.measure import folded_faces
 
 CORPUS = REPO.parent / "shared" / "corpus"
 """The shared corpus of real disk-topology meshes."""
+
+LIMBS = REPO.parent / "shared" / "corpus_limbs"
+"""OptCuts' benchmark inputs with long thin limbs (two hands, an armadillo, a dinosaur, a torso), disks,
+kept beside the repository with their provenance (its README.md) (issue 37)."""
 
 SIZES = {"1k": 1_000, "10k": 10_000, "100k": 100_000, "1M": 1_000_000}
 """Face counts of the generated surfaces, by the label used on the command line."""
@@ -595,6 +607,23 @@ def igl_harmonic_init(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return igl.harmonic(vertices, faces, boundary, circle, 1)
 
 
+def tutte_init(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Tutte's embedding: the boundary on the unit circle by arc length, every other vertex the mean of its
+    neighbours (uniform weights, one sparse solve): one-to-one on a disk, where the harmonic map of
+    :func:`igl_harmonic_init` (cotangent weights) can fold (the OptCuts armadillo: 11 triangles, the dinosaur 785)."""
+    boundary = igl.boundary_loop(faces)
+    circle = igl.map_vertices_to_circle(vertices, boundary.astype(np.int32))
+    adjacency = igl.adjacency_matrix(faces).astype(np.float64).tocsr()
+    laplacian = (sp.diags(np.asarray(adjacency.sum(axis=1)).ravel()) - adjacency).tocsr()
+    inner = np.setdiff1d(np.arange(len(vertices)), boundary)
+    uv = np.zeros((len(vertices), 2))
+    uv[boundary] = circle
+    solve = spla.factorized(laplacian[inner][:, inner].tocsc())
+    rhs = -(laplacian[inner][:, boundary] @ circle)
+    uv[inner] = np.column_stack([solve(np.ascontiguousarray(rhs[:, k])) for k in range(2)])
+    return uv
+
+
 def igl_arap(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """libigl ARAP parametrisation from the harmonic initialisation.
 
@@ -626,18 +655,20 @@ def igl_arap(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 def igl_slim(vertices: np.ndarray, faces: np.ndarray, iterations: int) -> tuple[np.ndarray, np.ndarray, float]:
-    """libigl SLIM (symmetric Dirichlet, no constraints) from the harmonic initialisation.
+    """libigl SLIM (symmetric Dirichlet, no constraints) from Tutte's embedding (:func:`tutte_init`), as SLIM's
+    paper starts it and issue 37 measures it (before issue 37: from the harmonic map, which can fold, and SLIM
+    keeps a folded start's folds).
 
     Returns
     -------
     uv : (n, 2) float64
     init : (n, 2) float64
-        The harmonic initialisation.
+        The Tutte initialisation.
     init_seconds : float
-        Time of the harmonic initialisation alone.
+        Time of the initialisation alone.
     """
     t0 = time.perf_counter()
-    init = igl_harmonic_init(vertices, faces)
+    init = tutte_init(vertices, faces)
     init_seconds = time.perf_counter() - t0
     data = igl.slim_precompute(
         np.asfortranarray(vertices),
@@ -663,10 +694,10 @@ def _mirror_if_reversed(faces: np.ndarray, uv: np.ndarray, row: Row) -> np.ndarr
     return uv
 
 
-def _init_note(faces: np.ndarray, init: np.ndarray, init_seconds: float) -> str:
-    """Note on the harmonic initialisation: its time and, if any, its folded triangles."""
+def _init_note(faces: np.ndarray, init: np.ndarray, init_seconds: float, label: str = "harmonic") -> str:
+    """Note on the initialisation: its time and, if any, its folded triangles."""
     folded = len(folded_faces(init, faces))
-    return f"harmonic init {init_seconds:.3f} s" + (f" ({folded} folded)" if folded else "")
+    return f"{label} init {init_seconds:.3f} s" + (f" ({folded} folded)" if folded else "")
 
 
 def run_libigl(name: str, vertices, faces, method: str, repeats: int, loops, max_faces_slim: int) -> Row:
@@ -701,7 +732,7 @@ def run_libigl(name: str, vertices, faces, method: str, repeats: int, loops, max
         elif method == "slim":
             seconds, (uv, init, init_seconds) = best_of(
                 lambda: igl_slim(vertices, faces, SLIM_ITERATIONS), repeats)
-            row.note = _init_note(faces, init, init_seconds) + f"; {SLIM_ITERATIONS} iterations"
+            row.note = _init_note(faces, init, init_seconds, "Tutte") + f"; {SLIM_ITERATIONS} iterations"
         else:
             raise ValueError(method)
     except (RuntimeError, ValueError, TypeError, MemoryError) as exc:  # reported in the row
@@ -1160,7 +1191,7 @@ lscm: igl.lscm, two farthest boundary vertices pinned; its uv is RESCALED by one
   total flat area = total 3D area before it is measured (LSCM has no scale of its own).
 arap: igl harmonic init (boundary on a circle) + arap_precomputation/arap_solve, 2D, default 10 iterations,
   one vertex held (translation only); time includes the harmonic init.
-slim: igl.slim_solve, symmetric Dirichlet, {slim} iterations, same harmonic init, included in the time.
+slim: igl.slim_solve, symmetric Dirichlet, {slim} iterations, from Tutte's embedding (uniform weights), included in the time.
 All rows measured by patterns.distortion and patterns.overlap_verdict (outside the timed region)."""
 
 
@@ -1211,6 +1242,12 @@ def mesh_sections(args) -> list:
         print(f"corpus: skipped ({CORPUS} does not exist)")
     else:
         sections.append(("Corpus (../shared/corpus/)", corpus_meshes(CORPUS, args.max_corpus_faces)))
+    if args.no_corpus:
+        pass
+    elif not LIMBS.is_dir():
+        print(f"thin limbs: skipped ({LIMBS} does not exist)")
+    else:
+        sections.append(("Thin limbs (../shared/corpus_limbs/)", corpus_meshes(LIMBS, args.max_corpus_faces)))
     sizes, extra_sizes = parse_sizes(args.sizes), parse_sizes(args.extra_sizes)
     if sizes or extra_sizes:
         sections.append(("Generated surfaces", generated_meshes(sizes, extra_sizes)))

@@ -42,8 +42,10 @@ print(json.dumps({"sha": hashlib.sha1(np.ascontiguousarray(r.uv).tobytes()).hexd
 
 
 def _run(root: Path, mesh: Path, repeats: int) -> dict:
+    # Run in ``root``: ``python -c`` puts the working directory first on sys.path, before PYTHONPATH, so run
+    # from anywhere else (the repository root, say) both versions would import that directory's patterns.
     proc = subprocess.run([sys.executable, "-c", _RUN, str(mesh), str(repeats)], capture_output=True, text=True,
-                          env=dict(os.environ, PYTHONPATH=str(root)), check=True)
+                          env=dict(os.environ, PYTHONPATH=str(root)), cwd=str(root), check=True)
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
