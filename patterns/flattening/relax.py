@@ -57,7 +57,7 @@ from ..mesh import Connectivity, edge_lengths
 from .embed import LDL, LDLFactor, factorize
 from .energy import ENERGIES, Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, dot, frames
 from .moves import boundary_crossings, edge_index, flip_free_steps, layout_size, safe_move
-from .slim import crushed_start, reweighted
+from .slim import SLIM_STEPS, crushed_start, reweighted
 
 _WINDOW = 2  # iterations over which progress is judged
 _STAGE_TOLERANCE = 30.0  # a barrier stage ends at this many times the tolerance
@@ -186,7 +186,8 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         # goes to the hybrid at once: ARAP's minimum crushed a triangle on every such mesh measured.
         if energy == "auto":
             energy = "hybrid"
-        uv, used = reweighted(fr, uv, conn.loops, energy=energy, iterations=min(20, max_iterations - iterations))
+        steps = min(SLIM_STEPS, max_iterations - iterations)
+        uv, used = reweighted(fr, uv, conn.loops, energy=energy, iterations=steps)
         iterations, barrier = iterations + used, 0.0
     guard = InverseTerm(fr, 1.0 + 1.0 / min_stretch**2) if min_stretch else None
     system = _System(conn, fr, free, seam, seam_index)

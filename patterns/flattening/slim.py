@@ -34,12 +34,13 @@ from .embed import LDL
 from .energy import Arap, Frames, Hybrid, SymmetricDirichlet
 from .moves import boundary_crossings, flip_free_steps, layout_size
 
-__all__ = ["CRUSHED_START", "crushed_start", "reweighted"]
+__all__ = ["CRUSHED_START", "SLIM_STEPS", "crushed_start", "reweighted"]
 
 CRUSHED_START = 1e-3
 """A start is carried by :func:`reweighted` first when 1 % of its area (3D) is squeezed below this stretch."""
 
-_ITERATIONS = 20  # steps at most (SLIM's usual count)
+SLIM_STEPS = 20
+"""Reweighted steps :func:`patterns.flattening.relax.relax` takes at most from a crushed start (SLIM's usual count)."""
 _TOLERANCE = 1e-3  # stop when the energy falls by less than this fraction in a step
 
 
@@ -105,7 +106,7 @@ def _proxy(jac, share: float):
 
 
 def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-dirichlet",
-               iterations: int = _ITERATIONS) -> tuple[np.ndarray, int]:
+               iterations: int = SLIM_STEPS) -> tuple[np.ndarray, int]:
     """Carry a one-to-one layout towards least distortion by SLIM's reweighted steps.
 
     Parameters
