@@ -59,7 +59,10 @@ def is_saddle(vertices: np.ndarray, faces: np.ndarray, loops) -> bool:
     ``vertices`` ``(n, 3)`` float64 mm, ``faces`` ``(m, 3)`` int64, ``loops`` its boundary loops (vertex
     index arrays; their vertices have no defect of their own).
     """
-    defects = angle_defects(vertices, faces, loops=loops)
+    return _mostly_negative(angle_defects(vertices, faces, loops=loops))
+
+
+def _mostly_negative(defects: np.ndarray) -> bool:
     return bool(np.maximum(-defects, 0.0).sum() > np.maximum(defects, 0.0).sum())
 
 
@@ -90,20 +93,22 @@ def slashed(model: Model, index: int, result: Flattening, limit: float, max_slas
         piece within the limit, or, if none does, the try that came closest.
     """
     before = worst_strain(result)
-    if before <= limit or not is_saddle(result.vertices, result.faces, result.loops):
+    if before <= limit:
         return model
     defects = angle_defects(result.vertices, result.faces, loops=result.loops)
+    if not _mostly_negative(defects):
+        return model
     first = int(np.clip(np.ceil(gore_bound(result, limit, defects=-defects)), 1, max_slashes))
-    excess = np.maximum(-defects, 0.0)
+    outline = _Outline(result, np.maximum(-defects, 0.0))
     best = (before, model)
     for k in range(first, max_slashes + 1):
-        worst, split = _slashed(model, index, result, excess, k, limit, options)
+        worst, split = _slashed(model, index, outline, k, limit, options)
         if worst < best[0]:
             best = (worst, split)
         if worst > limit:
             continue
         for fewer in range(k - 1, 0, -1):  # met at once: as few as meet
-            worst, split = _slashed(model, index, result, excess, fewer, limit, options)
+            worst, split = _slashed(model, index, outline, fewer, limit, options)
             if worst > limit:
                 break
             best = (worst, split)
@@ -111,12 +116,12 @@ def slashed(model: Model, index: int, result: Flattening, limit: float, max_slas
     return best[1]
 
 
-def _slashed(model, index, result, excess, k, limit, options) -> tuple:
+def _slashed(model, index, outline, k, limit, options) -> tuple:
     """``(worst strain of the pieces, model)`` of the first of :data:`_TRIES` that meets ``limit`` with ``k``
     slashes, or the closest; ``(inf, model)`` if none could be cut."""
     best = (np.inf, model)
     for depth, spread in _TRIES:
-        paths = _wedge_paths(result, excess, k, depth, spread)
+        paths = outline.wedge_paths(k, depth, spread)
         split = None if paths is None else split_panel(model, index, paths, inserts=True)
         if split is None or len(split.panels) != len(model.panels) + k:
             continue
@@ -128,38 +133,46 @@ def _slashed(model, index, result, excess, k, limit, options) -> tuple:
     return best
 
 
-def _wedge_paths(result: Flattening, excess: np.ndarray, k: int, depth: float, spread: float):
-    """``(vertices, faces, paths)``: the two cuts of each of ``k`` wedges put into the mesh, or None."""
-    uv, outer = result.uv, np.asarray(result.loops[0])
-    trough = crown_of(uv, excess)
-    ring = np.r_[outer, outer[:1]]
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(uv[ring], axis=0), axis=1))]
-    total = arc[-1]
-    flat = np.diff(arc)
-    real = np.linalg.norm(np.diff(result.vertices[ring], axis=0), axis=1)
-    window = max(1, len(outer) // 20)  # the most pressed stretch, not the most pressed edge
-    pressed = np.convolve(np.r_[flat[-window:], flat, flat[:window]] / np.r_[real[-window:], real, real[:window]],
-                          np.ones(2 * window + 1) / (2 * window + 1), "valid")
-    first = arc[int(np.argmin(pressed))]
-    angle = spread * float(excess.sum()) / k
-    v, f, p = result.vertices, result.faces, uv
-    paths, taken = [], []
-    for j in range(k):
-        at = (first + j * total / k) % total
-        start = uv[outer[int(np.argmin(np.abs(arc[:-1] - at)))]]
-        tip = int(np.argmin(np.linalg.norm(p - (start + depth * (trough - start)), axis=1)))
-        half = float(np.linalg.norm(p[tip] - start)) * np.tan(angle / 2.0)
-        if half >= total / (2 * k):
-            return None  # the wedges would meet on the outline
-        for side in (-1.0, 1.0):
-            corner = outer[int(np.argmin(np.abs(arc[:-1] - (at + side * half) % total)))]
-            inserted = insert_line(v, f, p, p[corner], p[tip], keep_off=taken)
-            v, f, p = inserted.vertices, inserted.faces, inserted.uv
-            if inserted.path[0] != corner or inserted.path[-1] != tip:
-                return None
-            paths.append(inserted.path)
-            taken += [int(x) for x in inserted.path[:-1]]
-    areas = face_areas(v, f)
-    if areas.min() < _SLIVER * float(np.median(areas)):
-        return None  # two cuts ran through one point short of the tip
-    return v, f, paths
+class _Outline:
+    """What every try's slashes are laid out from, found once per panel: the outer outline's arc length on
+    the layout, its most pressed point, the trough and the excess angle."""
+
+    def __init__(self, result: Flattening, excess: np.ndarray):
+        self.result, self.outer = result, np.asarray(result.loops[0])
+        uv = result.uv
+        self.trough, self.excess = crown_of(uv, excess), float(excess.sum())
+        ring = np.r_[self.outer, self.outer[:1]]
+        self.arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(uv[ring], axis=0), axis=1))]
+        flat = np.diff(self.arc)
+        real = np.linalg.norm(np.diff(result.vertices[ring], axis=0), axis=1)
+        window = max(1, len(self.outer) // 20)  # the most pressed stretch, not the most pressed edge
+        pressed = np.convolve(np.r_[flat[-window:], flat, flat[:window]] / np.r_[real[-window:], real, real[:window]],
+                              np.ones(2 * window + 1) / (2 * window + 1), "valid")
+        self.first = self.arc[int(np.argmin(pressed))]
+
+    def wedge_paths(self, k: int, depth: float, spread: float):
+        """``(vertices, faces, paths)``: the two cuts of each of ``k`` wedges put into the mesh, or None."""
+        result, outer, arc, trough, first = self.result, self.outer, self.arc, self.trough, self.first
+        uv, total = result.uv, arc[-1]
+        angle = spread * self.excess / k
+        v, f, p = result.vertices, result.faces, uv
+        paths, taken = [], []
+        for j in range(k):
+            at = (first + j * total / k) % total
+            start = uv[outer[int(np.argmin(np.abs(arc[:-1] - at)))]]
+            tip = int(np.argmin(np.linalg.norm(p - (start + depth * (trough - start)), axis=1)))
+            half = float(np.linalg.norm(p[tip] - start)) * np.tan(angle / 2.0)
+            if half >= total / (2 * k):
+                return None  # the wedges would meet on the outline
+            for side in (-1.0, 1.0):
+                corner = outer[int(np.argmin(np.abs(arc[:-1] - (at + side * half) % total)))]
+                inserted = insert_line(v, f, p, p[corner], p[tip], keep_off=taken)
+                v, f, p = inserted.vertices, inserted.faces, inserted.uv
+                if inserted.path[0] != corner or inserted.path[-1] != tip:
+                    return None
+                paths.append(inserted.path)
+                taken += [int(x) for x in inserted.path[:-1]]
+        areas = face_areas(v, f)
+        if areas.min() < _SLIVER * float(np.median(areas)):
+            return None  # two cuts ran through one point short of the tip
+        return v, f, paths

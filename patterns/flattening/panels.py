@@ -98,8 +98,7 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     mode = SeamLengths(opts.seams)
     eased_panels = {model.seams[s].panels[side] for s, side in eased}
     flat, targets = [], {}
-    slashed = {p.insert_into for p in model.panels if p.insert_into is not None}  # no darts on these, nor inserts
-    slashed |= {p.name for p in model.panels if p.insert_into is not None}
+    no_darts = {name for p in model.panels if p.insert_into is not None for name in (p.name, p.insert_into)}
     for i, panel in enumerate(model.panels):
         name = f"{model.name}: panel {panel.name}"
         darts, search = (), None
@@ -112,7 +111,7 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
                 held = held_lengths(model, i, vertices, eased, mode, mesh_edges=unique_edges(panel.faces))
             options = _engine_options(opts, name)
             result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
-            if max_strain is not None and not opts.gores and panel.name not in slashed:
+            if max_strain is not None and not opts.gores and panel.name not in no_darts:  # slashed, or an insert
                 result, darts, search = cut_darts(result, max_strain, max_darts, held, options)
         targets.update(_side_targets(model, i, result, eased, mode))
         if panel.name in grains:

@@ -202,8 +202,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         run = _Minimiser(_Objective(main, InverseTerm(fr), guard, seam), system, faces, conn.loops, free,
                          tolerance=tolerance * (_PROBE if probe else 1.0), floor=floor,
                          length_tolerance=length_tolerance, progress=progress, offset=iterations,
-                         total=max_iterations)
-        run.refresh = _REFRESH_FAR if carried else _REFRESH
+                         total=max_iterations, refresh=_REFRESH_FAR if carried else _REFRESH)
         uv, used, converged = run(uv, mu if chosen == "arap" else 0.0, max_iterations - iterations)
         iterations += used
         if energy != "auto" or chosen != "arap" or iterations >= max_iterations:
@@ -373,8 +372,9 @@ class _Minimiser:
     """
 
     def __init__(self, objective, system, faces, loops, free, *, tolerance, floor, length_tolerance, progress,
-                 offset, total):
+                 offset, total, refresh=_REFRESH):
         self.objective, self.system, self.faces, self.loops, self.free = objective, system, faces, loops, free
+        self.refresh = refresh  # iterations between refactorisations of the stiffened matrix
         self.tolerance, self.floor, self.length_tolerance = tolerance, floor, length_tolerance
         self.progress, self.offset, self.total = progress, offset, total
         self.everywhere = bool(free.all())

@@ -72,7 +72,8 @@ class _System:
 
 
 def _stiffness(fr: Frames) -> np.ndarray:
-    """``(m, 3, 3)``: each triangle's ``C C^T`` (``J = P R^-1`` as ``sum_c u_c C_c``), times its weight."""
+    """``(W C C^T, C)``, ``(m, 3, 3)`` and ``(m, 3, 2)``: each triangle's ``C`` (``J = sum_c u_c C_c``, row ``c`` for
+    corner ``c``) and its cotangent stiffness ``C C^T`` times its weight ``W``."""
     r11, r12, r21, r22 = fr.inverse
     c = np.stack([np.column_stack([-(r11 + r21), r11, r21]), np.column_stack([-(r12 + r22), r12, r22])], axis=2)
     return fr.weight[:, None, None] * np.einsum("mij,mkj->mik", c, c), c
@@ -135,11 +136,12 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
     share = {"arap": 0.0, "hybrid": Hybrid.share, "symmetric-dirichlet": 1.0}[energy]
     energy = {"arap": Arap, "hybrid": Hybrid, "symmetric-dirichlet": SymmetricDirichlet}[energy](fr)
     uv = np.array(uv, dtype=np.float64)
-    value = energy.terms(fr.jacobian(uv))[0]
+    jac = fr.jacobian(uv)
+    value = energy.terms(jac)[0]
     size = layout_size(uv)
     used = 0
     for used in range(1, iterations + 1):
-        weight, target = _proxy(fr.jacobian(uv), share)
+        weight, target = _proxy(jac, share)
         blocks = (weight[:, :, None, :, None] * stiff[:, None, :, None, :]).reshape(-1, 36)  # (k, c) x (l, c')
         values = np.bincount(system.slot, weights=blocks[system.upper], minlength=system.n_entries)
         proximal = 1e-9 * float(values[system.diagonal].mean())  # holds the translation; biases nothing else
@@ -155,14 +157,15 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
         smallest = 1e-13 * size / max(float(np.abs(direction).max()), 1e-300)
         while step > smallest:
             cand = uv + step * direction
-            terms = energy.terms(fr.jacobian(cand))
+            cand_jac = fr.jacobian(cand)
+            terms = energy.terms(cand_jac)
             if terms is not None and terms[0] < value and boundary_crossings(cand, loops) is None:
                 break
             step *= 0.5
         else:
             return uv, used
         gain = (value - terms[0]) / value
-        uv, value = cand, terms[0]
+        uv, value, jac = cand, terms[0], cand_jac
         if gain < _TOLERANCE:
             break
     return uv, used
