@@ -13,9 +13,9 @@ Meshes
   root (up to ``--max-corpus-faces`` faces), loaded with
   ``trimesh.load(path, process=False)`` (skipped, with the reason printed, when
   the folder is absent or ``--no-corpus`` is given);
-* the same of ``../shared/corpus_limbs/`` (:data:`LIMBS`, issue 37): OptCuts' benchmark
-  inputs with long thin limbs (two hands, an armadillo, a dinosaur, a torso with arms),
-  their provenance in that folder's README.md;
+* the same of ``benchmarks/data/limbs/`` (:data:`LIMBS`, issue 37; ``*.obj.gz``, bundled):
+  OptCuts' benchmark inputs with long thin limbs (two hands, an armadillo, a dinosaur, a torso
+  with arms), their provenance and licence in that folder's README.md;
 * generated surfaces at about 1k, 10k, 100k and 1M faces (``--sizes``): a 60
   degree spherical cap (``cap60``: radius 100 mm, polar half-angle 30 degrees), a
   paraboloid dish, a saddle and a half cylinder (exactly developable); and at
@@ -85,6 +85,7 @@ with the numbers, and a count of PASS/FAIL per criterion:
 from __future__ import annotations
 
 import argparse
+import gzip
 import json
 import os
 import platform
@@ -113,9 +114,9 @@ from patterns.measure import folded_faces
 CORPUS = REPO.parent / "shared" / "corpus"
 """The shared corpus of real disk-topology meshes."""
 
-LIMBS = REPO.parent / "shared" / "corpus_limbs"
+LIMBS = REPO / "benchmarks" / "data" / "limbs"
 """OptCuts' benchmark inputs with long thin limbs (two hands, an armadillo, a dinosaur, a torso), disks,
-kept beside the repository with their provenance (its README.md) (issue 37)."""
+bundled gzip-compressed with their provenance and licence (its README.md) (issue 37)."""
 
 SIZES = {"1k": 1_000, "10k": 10_000, "100k": 100_000, "1M": 1_000_000}
 """Face counts of the generated surfaces, by the label used on the command line."""
@@ -389,21 +390,29 @@ def generated_meshes(sizes: list[tuple[str, int]], extra_sizes: list[tuple[str, 
 
 
 def corpus_meshes(folder: Path, max_faces: int | None = None):
-    """Yield ``(name, vertices, faces)`` for every ``*.obj`` and ``*.off`` in ``folder``.
+    """Yield ``(name, vertices, faces)`` for every ``*.obj``, ``*.off`` and ``*.obj.gz`` in ``folder``.
 
-    Loaded with ``trimesh.load(path, process=False)``: vertices are neither merged
-    nor reordered.  Meshes with more than ``max_faces`` faces are left out (and
-    named on stderr).
+    Loaded with ``trimesh.load(path, process=False)`` (a ``.gz`` through
+    :func:`gzip.open`): vertices are neither merged nor reordered.  Meshes with
+    more than ``max_faces`` faces are left out (and named on stderr).
     """
-    paths = sorted(p for p in folder.iterdir() if p.suffix.lower() in (".obj", ".off"))
+    paths = sorted(p for p in folder.iterdir() if p.name.lower().endswith((".obj", ".off", ".obj.gz")))
     for path in paths:
-        mesh = trimesh.load(path, process=False)
+        mesh = load_mesh(path)
         if max_faces is not None and len(mesh.faces) > max_faces:
             print(f"  {path.name}: left out ({len(mesh.faces)} > {max_faces} faces)", file=sys.stderr)
             continue
         vertices = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
         faces = np.ascontiguousarray(mesh.faces, dtype=np.int64)
-        yield path.name, vertices, faces
+        yield path.name.removesuffix(".gz"), vertices, faces
+
+
+def load_mesh(path: Path) -> trimesh.Trimesh:
+    """``trimesh.load(path, process=False)``, or of the decompressed OBJ where ``path`` ends in ``.gz``."""
+    if path.name.lower().endswith(".gz"):
+        with gzip.open(path) as stream:
+            return trimesh.load(stream, file_type="obj", process=False)
+    return trimesh.load(path, process=False)
 
 
 def shuffle_mesh(vertices: np.ndarray, faces: np.ndarray, seed: int = SHUFFLE_SEED):
@@ -1247,7 +1256,7 @@ def mesh_sections(args) -> list:
     elif not LIMBS.is_dir():
         print(f"thin limbs: skipped ({LIMBS} does not exist)")
     else:
-        sections.append(("Thin limbs (../shared/corpus_limbs/)", corpus_meshes(LIMBS, args.max_corpus_faces)))
+        sections.append(("Thin limbs (benchmarks/data/limbs/)", corpus_meshes(LIMBS, args.max_corpus_faces)))
     sizes, extra_sizes = parse_sizes(args.sizes), parse_sizes(args.extra_sizes)
     if sizes or extra_sizes:
         sections.append(("Generated surfaces", generated_meshes(sizes, extra_sizes)))

@@ -1,5 +1,7 @@
 """Reweighted local-global steps (SLIM's proxy) for far starts with crushed parts (issue 37)."""
 
+import gzip
+import hashlib
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +14,7 @@ from patterns.flattening.slim import _proxy, crushed_start, reweighted
 from patterns.measure import signed_areas
 from patterns.mesh import edge_lengths, validate_mesh
 
-LIMBS = Path(__file__).resolve().parent.parent.parent / "shared" / "corpus_limbs"
+LIMBS = Path(__file__).resolve().parent.parent / "benchmarks" / "data" / "limbs"
 
 
 def test_the_proxy_is_slims_from_the_singular_value_decomposition():
@@ -28,7 +30,7 @@ def test_the_proxy_is_slims_from_the_singular_value_decomposition():
     for share in (0.0, 0.5, 1.0):
         a2 = (1.0 - share) + share * (s + 1.0) * (s * s + 1.0) / (4.0 * s ** 3)
         expected = np.einsum("mik,mk,mjk->mij", u, a2, u)
-        weight, target = _proxy(jac, share)
+        weight, target = _proxy(jac, (1.0 - share, 0.25 * share))
         np.testing.assert_allclose(weight, expected, rtol=1e-9, atol=1e-12 * np.abs(expected).max())
         np.testing.assert_allclose(target, expected @ (u @ vt), rtol=1e-9, atol=1e-12 * np.abs(expected).max())
 
@@ -72,24 +74,36 @@ def test_reweighted_steps_carry_a_crushed_start_of_a_flat_hand_to_its_true_shape
     after = sd.terms(fr.jacobian(carried))[0]
     assert 1 <= used <= 20 and after < 1e-3 * before
     assert np.all(signed_areas(carried, f) > 0) and patterns.overlap_verdict(carried, f, conn.loops).one_to_one
-    result = relax(v, f, conn, start, barrier=0.1, tolerance=1e-9, max_iterations=2000)
-    assert result.energy == "hybrid" and np.all(signed_areas(result.uv, f) > 0)
     e = conn.edges
-    flat = np.linalg.norm(result.uv[e[:, 1]] - result.uv[e[:, 0]], axis=1)
-    np.testing.assert_allclose(flat, edge_lengths(v, e), rtol=1e-4)
+    outline = conn.loops[0]
+    seam = np.column_stack([outline, np.roll(outline, -1)])  # the outline held at its 3D length, edge by edge
+    for lengths in (None, (seam, edge_lengths(v, seam))):
+        result = relax(v, f, conn, start, barrier=0.1, tolerance=1e-9, max_iterations=2000, lengths=lengths)
+        assert result.energy == "hybrid" and np.all(signed_areas(result.uv, f) > 0)
+        flat = np.linalg.norm(result.uv[e[:, 1]] - result.uv[e[:, 0]], axis=1)
+        np.testing.assert_allclose(flat, edge_lengths(v, e), rtol=1e-4)
+
+
+def test_the_bundled_thin_limbed_meshes_are_the_bytes_their_readme_names():
+    """Every ``*.obj.gz`` of ``benchmarks/data/limbs`` decompresses to the sha256 its README's table gives."""
+    readme = (LIMBS / "README.md").read_text()
+    files = sorted(LIMBS.glob("*.obj.gz"))
+    assert len(files) == 5
+    for path in files:
+        row = next(line for line in readme.splitlines() if f"`{path.name}`" in line)
+        assert hashlib.sha256(gzip.decompress(path.read_bytes())).hexdigest() in row
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(not LIMBS.is_dir(), reason=f"{LIMBS} is absent (OptCuts' thin-limbed meshes, kept beside the "
-                                                  "repository)")
-@pytest.mark.parametrize("name", ["optcuts_hand_1_i_f5000.obj", "optcuts_armadillo_i_f10000.obj",
-                                  "optcuts_dilo_o_f10000.obj", "optcuts_hand_2_i_f10000.obj"])
+@pytest.mark.parametrize("name", ["optcuts_hand_1_i_f5000.obj.gz", "optcuts_armadillo_i_f10000.obj.gz",
+                                  "optcuts_dilo_o_f10000.obj.gz", "optcuts_hand_2_i_f10000.obj.gz"])
 def test_thin_limbed_meshes_flatten_one_to_one_and_uncrushed(name):
     """Issue 37's quality criteria on OptCuts' hands, armadillo and dinosaur (the speed is the
     benchmark's): no fold, one-to-one, the 1st-percentile smallest stretch at least 0.1."""
     import trimesh
 
-    mesh = trimesh.load(LIMBS / name, process=False)
+    with gzip.open(LIMBS / name) as stream:
+        mesh = trimesh.load(stream, file_type="obj", process=False)
     v, f = np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
     result = patterns.flatten_mesh(v, f, name=name)
     measured = patterns.distortion(v, f, result.uv)

@@ -211,7 +211,14 @@ def frames(vertices: np.ndarray, faces: np.ndarray, *, local: np.ndarray | None 
 
 
 class _TriangleEnergy:
-    """A sum of per-triangle terms: subclasses give :meth:`terms`, ``(value, dE/dJ entries)`` or None where folded."""
+    """A sum of per-triangle terms: subclasses give :meth:`terms`, ``(value, dE/dJ entries)`` or None where folded.
+
+    The distortion energies are ``sum_t W_t (f(sigma1) + f(sigma2))`` with
+    ``f(s) = p (s - 1)**2 + q (s**2 + s**-2 - 2)``; ``stretch`` is their ``(p, q)``
+    (what SLIM's proxy and the projected Hessian of :mod:`.hessian` are built from).
+    """
+
+    stretch: tuple[float, float] | None = None
 
     def __init__(self, fr: Frames):
         self.fr = fr
@@ -238,6 +245,7 @@ class Arap(_TriangleEnergy):
     """
 
     name = "arap"
+    stretch = (1.0, 0.0)  # (p, q) of the per-stretch term, see _TriangleEnergy
 
     def terms(self, jac):
         ar, ai, br, bi = jac.conformal_parts()
@@ -267,6 +275,7 @@ class SymmetricDirichlet(_TriangleEnergy):
     """
 
     name = "symmetric-dirichlet"
+    stretch = (0.0, 1.0)
 
     def terms(self, jac):
         det = jac.det
@@ -292,6 +301,7 @@ class Hybrid(_TriangleEnergy):
 
     name = "hybrid"
     share = 0.5  # t
+    stretch = (1.0 - share, 0.25 * share)
 
     def __init__(self, fr: Frames):
         super().__init__(fr)

@@ -33,15 +33,18 @@ Method
   without folds and without overlap, by the same degree argument as
   :mod:`patterns.audit`.  Nothing is ever rescaled.
 * **Far, crushed starts.**  A start with 1 % of its area squeezed below a
-  stretch of 1e-3 (the thin limbs of a conformal or Tutte layout: a hand's
+  stretch of 1e-2 (the thin limbs of a conformal or Tutte layout: a hand's
   fingertips at 1e-6 of their size) is first carried near by at most 20
   reweighted local-global steps of SLIM's proxy (:mod:`.slim`), then relaxed
-  from there without barrier stages (the stiffened matrix refactorised every
-  20 iterations, not 5); ``"auto"`` then minimises the hybrid at
+  from there without barrier stages, the L-BFGS ``H0`` being the energy's
+  projected Newton Hessian (:mod:`.hessian`, refactorised every 4 iterations)
+  instead of the stiffened Laplacian, which cannot describe triangles
+  stretched 7:1 one way; ``"auto"`` then minimises the hybrid at
   once (ARAP's fold-free minimum crushed a triangle on every such mesh of the
   two corpora: the OptCuts hands, armadillo, dinosaur and torso, two BFF
   heads).  Gradient steps inflate such parts by a few per cent an iteration:
-  300-400 iterations where the reweighted steps take 12-20.
+  300-400 iterations where the reweighted steps take 12-20, and the
+  Laplacian-preconditioned tail after them 250-500 where this one takes 30-110.
 * **Pins** are reached first by stress-majorization steps cut vertex by vertex
   (:func:`_travel_to_pins`), then held while the rest relaxes.
 """
@@ -56,15 +59,16 @@ import scipy.sparse as sp
 from ..mesh import Connectivity, edge_lengths
 from .embed import LDL, LDLFactor, factorize
 from .energy import ENERGIES, Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, dot, frames
+from .hessian import PairFactor, PairSystem, corner_columns, projected_hessian
 from .moves import boundary_crossings, edge_index, flip_free_steps, layout_size, safe_move
 from .slim import SLIM_STEPS, crushed_start, reweighted
 
 _WINDOW = 2  # iterations over which progress is judged
 _STAGE_TOLERANCE = 30.0  # a barrier stage ends at this many times the tolerance
 _REFRESH = 5  # iterations between refactorisations while the matrix is stiffened
-_REFRESH_FAR = 20  # the same after reweighted steps from a crushed start (hand_1: 5, 10, 20, 40, never: 293, 232, 200,
-# 271, 500 iterations; the stiffness moves less once the limbs are open, and the L-BFGS pairs, cleared at each
-# refactorisation, are worth more than a fresher matrix)
+_REFRESH_NEWTON = 4  # iterations between projected Hessians after reweighted steps from a crushed start (lucy,
+# hand_yaron, hand_1: 1, 2, 4, 8 measured; 4 the fastest, a factorisation costing about 4 L-BFGS iterations)
+_PROXIMAL = 1e-6  # the projected Hessian's diagonal is raised by this fraction of its mean (a rigid turn is free)
 _MEMORY = 8  # L-BFGS pairs kept
 _DROP = 0.1  # the barrier weight is multiplied by this at each new stage
 _WEAKEST = 1e-5  # the last barrier stage before the energy alone
@@ -180,6 +184,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
             return Relaxation(uv, iterations, False, _length_error(seam, uv), "arap" if energy == "auto" else energy)
         uv[pin_index] = pin_target
     carried = barrier > 0 and pins is None and crushed_start(fr, uv)
+    pair = None
     if carried:
         # A far start with crushed parts (the thin limbs of a conformal or Tutte layout): carried near by
         # reweighted steps first (:mod:`.slim`), then relaxed from there with no barrier stages.  "auto"
@@ -187,10 +192,11 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         if energy == "auto":
             energy = "hybrid"
         steps = min(SLIM_STEPS, max_iterations - iterations)
-        uv, used = reweighted(fr, uv, conn.loops, energy=energy, iterations=steps)
+        pair = PairSystem(fr, n)
+        uv, used = reweighted(fr, uv, conn.loops, energy=energy, iterations=steps, system=pair)
         iterations, barrier = iterations + used, 0.0
     guard = InverseTerm(fr, 1.0 + 1.0 / min_stretch**2) if min_stretch else None
-    system = _System(conn, fr, free, seam, seam_index)
+    system = _System(conn, fr, free, seam, seam_index, pair=pair)
     chosen = "arap" if energy == "auto" else energy
     main = {"arap": Arap, "hybrid": Hybrid, "symmetric-dirichlet": SymmetricDirichlet}[chosen](fr)
     converged = False
@@ -202,7 +208,7 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         run = _Minimiser(_Objective(main, InverseTerm(fr), guard, seam), system, faces, conn.loops, free,
                          tolerance=tolerance * (_PROBE if probe else 1.0), floor=floor,
                          length_tolerance=length_tolerance, progress=progress, offset=iterations,
-                         total=max_iterations, refresh=_REFRESH_FAR if carried else _REFRESH)
+                         total=max_iterations, refresh=_REFRESH_NEWTON if carried else _REFRESH)
         uv, used, converged = run(uv, mu if chosen == "arap" else 0.0, max_iterations - iterations)
         iterations += used
         if energy != "auto" or chosen != "arap" or iterations >= max_iterations:
@@ -302,8 +308,9 @@ class _System:
     the steps); stiffened ones are refactorised numerically only by qdldl.
     """
 
-    def __init__(self, conn, fr, free, seam, seam_index):
-        self.conn, self.fr, self.free = conn, fr, free
+    def __init__(self, conn, fr, free, seam, seam_index, *, pair: PairSystem | None = None):
+        self.conn, self.fr, self.free, self.pair = conn, fr, free, pair
+        self._columns = None if pair is None else corner_columns(fr)
         self.extra = np.zeros(len(conn.edges))
         if seam is not None:
             np.add.at(self.extra, seam_index, seam.edge_weights())
@@ -317,6 +324,16 @@ class _System:
         """Edge weights ``(e,)`` of ``K`` for triangle scales ``scale`` ``(m,)`` (None: all 1)."""
         coef = self.fr.dirichlet_weights(scale) * 2.0
         return np.bincount(self.conn.face_edges.ravel(), coef.ravel(), len(self.conn.edges)) + self.extra
+
+    def hessian(self, u: np.ndarray, main) -> PairFactor:
+        """The projected Hessian of ``main`` at ``u`` plus the seam stiffness, factorised (``pair`` given)."""
+        values = self.pair.assemble(projected_hessian(self.fr, self.fr.jacobian(u), main.stretch,
+                                                      columns=self._columns))
+        if self.extra.any():
+            values += self.pair.laplacian(self.conn.edges, self.extra)
+        values[self.pair.diagonal] += _PROXIMAL * float(values[self.pair.diagonal].mean())
+        values[self.pair.diagonal[[0, self.pair.n]]] += self.anchor
+        return self.pair.factorize(values)
 
     def stiffened(self, stiffness: np.ndarray):
         """``K`` with triangle scales ``1 + stiffness``, factorised; the plain factor when that changes little."""
@@ -379,6 +396,7 @@ class _Minimiser:
         self.progress, self.offset, self.total = progress, offset, total
         self.everywhere = bool(free.all())
         self.sd = not isinstance(objective.main, Arap)  # a barrier itself: its matrix follows the squeeze
+        self.newton = system.pair is not None  # H0 the projected Hessian (after reweighted steps)
         self.size = None  # the layout's size, for the smallest useful step (set at the start)
 
     def restrict(self, g):
@@ -403,6 +421,8 @@ class _Minimiser:
 
     def factor(self, u, mu):
         """The preconditioner for the current stage at ``u``."""
+        if self.newton:
+            return self.system.hessian(u, self.objective.main)
         if self.sd:
             return self.system.stiffened(self.objective.barrier.stiffness(u))
         if mu > 0:
@@ -416,7 +436,7 @@ class _Minimiser:
         value, grad, parts = self.evaluate(uv, mu)
         lu, hgrad, memory = self.factor(uv, mu), None, _Memory()
         since_refresh, recent, rounds = 0, [value], 0
-        stiff = self.sd or mu > 0
+        stiff = self.sd or self.newton or mu > 0
         iterations = 0
         while iterations < max_iterations:
             iterations += 1
@@ -455,7 +475,7 @@ class _Minimiser:
                 value, grad, parts = self.evaluate(uv, mu)  # new multipliers: a new energy
             else:
                 mu = mu * _DROP if mu > _WEAKEST * 1.5 else 0.0
-                stiff = self.sd or mu > 0
+                stiff = self.sd or self.newton or mu > 0
                 value, grad = self.reweigh(parts, mu)  # the terms are at hand
             lu, hgrad, since_refresh, recent = self.factor(uv, mu), None, 0, [value]
             memory.clear()

@@ -30,14 +30,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from .embed import LDL
 from .energy import Arap, Frames, Hybrid, SymmetricDirichlet
+from .hessian import PairSystem, corner_columns
 from .moves import boundary_crossings, flip_free_steps, layout_size
 
 __all__ = ["CRUSHED_START", "SLIM_STEPS", "crushed_start", "reweighted"]
 
-CRUSHED_START = 1e-3
-"""A start is carried by :func:`reweighted` first when 1 % of its area (3D) is squeezed below this stretch."""
+CRUSHED_START = 1e-2
+"""A start is carried by :func:`reweighted` first when 1 % of its area (3D) is squeezed below this stretch.
+
+(1e-3 at first; the five OptCuts starts between 1e-3 and 1e-2 -- chinese lion, evil, foot,
+gargoyle, vase -- all ended in the hybrid by the other path too, and carried they took 0.5-0.9
+of its time at a lower energy.  The lowest start measured whose ARAP minimum crushes nothing,
+the BFF spot head, is at 1.5e-2.)"""
 
 SLIM_STEPS = 20
 """Reweighted steps :func:`patterns.flattening.relax.relax` takes at most from a crushed start (SLIM's usual count)."""
@@ -52,46 +57,26 @@ def crushed_start(fr: Frames, uv: np.ndarray) -> bool:
     return bool(s2[order][np.searchsorted(share, 0.01)] < CRUSHED_START**2)
 
 
-class _System:
-    """The ``2 n`` by ``2 n`` matrix's pattern and the scatter of every triangle's 36 entries into it."""
-
-    def __init__(self, fr: Frames, n: int):
-        corners = np.column_stack(fr.corners)  # (m, 3)
-        # Unknown (k, vertex) at k * n + vertex; a triangle's six in the order (u0, u1, u2, v0, v1, v2).
-        local = np.hstack([corners, corners + n])  # (m, 6)
-        rows, cols = np.repeat(local, 6, axis=1), np.tile(local, (1, 6))  # (m, 36): entry (a, b) at 6 a + b
-        upper = rows <= cols
-        r, c = rows[upper], cols[upper]
-        key = r * (2 * n) + c
-        unique, self.slot = np.unique(key, return_inverse=True)
-        self.upper = upper
-        self.ldl = LDL(2 * n, unique // (2 * n), unique % (2 * n))
-        self.n_entries = len(unique)
-        self.diagonal = np.flatnonzero(unique // (2 * n) == unique % (2 * n))
-        self.local = local
+def _stiffness(fr: Frames, c: np.ndarray) -> np.ndarray:
+    """``W C C^T``, ``(m, 3, 3)``: each triangle's cotangent stiffness times its weight (``C`` its
+    :func:`.hessian.corner_columns`)."""
+    return fr.weight[:, None, None] * np.einsum("mij,mkj->mik", c, c)
 
 
-def _stiffness(fr: Frames) -> np.ndarray:
-    """``(W C C^T, C)``, ``(m, 3, 3)`` and ``(m, 3, 2)``: each triangle's ``C`` (``J = sum_c u_c C_c``, row ``c`` for
-    corner ``c``) and its cotangent stiffness ``C C^T`` times its weight ``W``."""
-    r11, r12, r21, r22 = fr.inverse
-    c = np.stack([np.column_stack([-(r11 + r21), r11, r21]), np.column_stack([-(r12 + r22), r12, r22])], axis=2)
-    return fr.weight[:, None, None] * np.einsum("mij,mkj->mik", c, c), c
-
-
-def _proxy(jac, share: float):
+def _proxy(jac, stretch: tuple[float, float]):
     """``(A^2, A^2 R)``, each ``(m, 2, 2)``, of every triangle, in closed form.
 
     ``J z = alpha z + beta conj(z)``: ``s1, s2 = |alpha| +- |beta|``, ``R`` the
     rotation by ``arg alpha``, ``U`` by ``(arg alpha + arg beta) / 2``.  Per
-    stretch ``a^2 = f'(s) / (2 (s - 1))`` of ``f = (1 - share) (s - 1)^2 +
-    share (s^2 + s^-2 - 2) / 4`` (``share`` 1: the symmetric Dirichlet
-    energy up to a factor, 1/2: the hybrid), continuous through ``s = 1``.
+    stretch ``a^2 = f'(s) / (2 (s - 1)) = p + q (s + 1)(s^2 + 1) / s^3`` of the
+    energy's ``f = p (s - 1)^2 + q (s^2 + s^-2 - 2)`` (``stretch = (p, q)``),
+    continuous through ``s = 1``.
     """
     ar, ai, br, bi = jac.conformal_parts()
     na, nb = np.hypot(ar, ai), np.hypot(br, bi)
     s = np.stack([na + nb, na - nb], axis=1)  # (m, 2), positive on a one-to-one layout
-    a2 = (1.0 - share) + 0.25 * share * (s + 1.0) * (s * s + 1.0) / s ** 3
+    p, q = stretch
+    a2 = p + q * (s + 1.0) * (s * s + 1.0) / s ** 3
     mean, half = 0.5 * (a2[:, 0] + a2[:, 1]), 0.5 * (a2[:, 0] - a2[:, 1])
     # cos, sin of 2 arg U = arg alpha + arg beta: alpha beta / |alpha beta| (any angle where beta = 0: half is 0).
     norm = np.maximum(na * nb, 1e-300)
@@ -107,7 +92,7 @@ def _proxy(jac, share: float):
 
 
 def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-dirichlet",
-               iterations: int = SLIM_STEPS) -> tuple[np.ndarray, int]:
+               iterations: int = SLIM_STEPS, system: PairSystem | None = None) -> tuple[np.ndarray, int]:
     """Carry a one-to-one layout towards least distortion by SLIM's reweighted steps.
 
     Parameters
@@ -122,6 +107,8 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
         The distortion (:mod:`patterns.flattening.energy`) whose proxy is solved and which each step lowers.
     iterations : int
         Steps at most; fewer when a step lowers the energy by less than 0.1 %.
+    system : PairSystem, optional
+        The mesh's :class:`~patterns.flattening.hessian.PairSystem`, if at hand (built otherwise).
 
     Returns
     -------
@@ -131,9 +118,9 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
         Steps taken.
     """
     n = len(uv)
-    system = _System(fr, n)
-    stiff, c = _stiffness(fr)
-    share = {"arap": 0.0, "hybrid": Hybrid.share, "symmetric-dirichlet": 1.0}[energy]
+    system = PairSystem(fr, n) if system is None else system
+    c = corner_columns(fr)
+    stiff = _stiffness(fr, c)
     energy = {"arap": Arap, "hybrid": Hybrid, "symmetric-dirichlet": SymmetricDirichlet}[energy](fr)
     uv = np.array(uv, dtype=np.float64)
     jac = fr.jacobian(uv)
@@ -141,16 +128,15 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
     size = layout_size(uv)
     used = 0
     for used in range(1, iterations + 1):
-        weight, target = _proxy(jac, share)
-        blocks = (weight[:, :, None, :, None] * stiff[:, None, :, None, :]).reshape(-1, 36)  # (k, c) x (l, c')
-        values = np.bincount(system.slot, weights=blocks[system.upper], minlength=system.n_entries)
+        weight, target = _proxy(jac, energy.stretch)
+        values = system.assemble(weight[:, :, None, :, None] * stiff[:, None, :, None, :])  # (k, c) x (l, c')
         proximal = 1e-9 * float(values[system.diagonal].mean())  # holds the translation; biases nothing else
         values[system.diagonal] += proximal
         # Right-hand side: each triangle's W (A^2 R) C^T, scattered to its corners.
         local = fr.weight[:, None, None] * np.einsum("mkj,mcj->mkc", target, c)  # (m, 2, 3)
         rhs = np.bincount(system.local.ravel(), weights=local.reshape(len(local), 6).ravel(), minlength=2 * n)
         rhs += proximal * np.concatenate([uv[:, 0], uv[:, 1]])
-        x = system.ldl.factorize(values).solve(rhs)
+        x = system.factorize(values).solve(rhs)
         direction = np.column_stack([x[:n], x[n:]]) - uv
         step = min(1.0, 0.9 * float(flip_free_steps(uv, fr.faces, direction, horizon=1.0 / 0.9,
                                                      corners=fr.corners).min()))
