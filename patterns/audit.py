@@ -276,7 +276,7 @@ def _check_pattern(pattern: Pattern, opts: CheckOptions) -> Report:
         report, found = _panel_report(flat, max_strain)
         panel_reports.append(report)
         findings += found + _usable(flat, report, opts)
-    findings += _overlaps_between(pattern) + _insert_notes(pattern, max_strain)
+    findings += _overlaps_between(pattern) + _insert_notes(pattern, max_strain) + _gore_notes(pattern, max_strain)
     seam_reports = []
     for fs in pattern.seams:
         report, found = _seam_report(pattern, fs, max_seam_mismatch)
@@ -428,6 +428,29 @@ def _insert_notes(pattern, max_strain) -> list:
             text += (f"; the strain limit {max_strain:.2%} was not met: the worst piece reaches {worst[at]:.2%} "
                      f"(panel {pieces[at].name}): allow more slashes (max_darts), or cut gores")
         out.append(Finding(Code.INSERTS, Severity.NOTE, (name, *inserts), uv[sorted(tips)], (), None, text))
+    return out
+
+
+def _gore_notes(pattern, max_strain) -> list:
+    """The note on each panel split into gores: how many, and whether every gore met the strain limit they were
+    cut for; its panels are the gores, the one of highest strain first, and its point that gore's worst triangle."""
+    out = []
+    for name in dict.fromkeys(f.panel.gore_of for f in pattern.panels if f.panel.gore_of is not None):
+        gores = [f for f in pattern.panels if f.panel.gore_of == name]
+        worst = [float(f.strains.magnitude.max()) for f in gores]
+        at = int(np.argmax(worst))
+        first = gores[at]
+        i = int(np.argmax(first.strains.magnitude))
+        point = first.uv[first.faces[i]].mean(axis=0)
+        names = [g.name for g in gores]
+        listed = ", ".join(names) if len(names) <= 4 else f"{names[0]} ... {names[-1]}"
+        text = (f"panel {name}: split into {counted(len(gores), 'gore')} ({listed}) along cuts from its outline "
+                f"to its crown, each cut a seam held at its 3D length")
+        if max_strain is not None and worst[at] > max_strain:
+            text += (f"; the strain limit {max_strain:.2%} was not met: the worst gore reaches {worst[at]:.2%} at "
+                     f"({point[0]:.1f}, {point[1]:.1f}) mm (panel {first.name}): allow more gores (max_gores)")
+        panels = (first.name, *(g.name for g in gores if g is not first))
+        out.append(Finding(Code.GORES, Severity.NOTE, panels, point[None, :], (), None, text))
     return out
 
 

@@ -50,6 +50,9 @@ class Code(str, Enum):
     INSERTS = "inserts"
     """A saddle-shaped panel slashed from its outline by ``flatten(max_strain=...)``, each slash's wedge cut out
     as an insert that is sewn back into it (:mod:`patterns.flattening.inserts`)."""
+    GORES = "gores"
+    """A panel split into gores by ``flatten(max_strain=..., gores=True)``, each cut a seam
+    (:mod:`patterns.flattening.gores`)."""
     FLANGES_OVERLAP = "flanges-overlap"
     """Faces of a blank that land on one another once unfolded: it cannot be cut in one piece."""
     BEND_WITHOUT_FLANGE = "bend-without-flange"

@@ -98,6 +98,10 @@ class Panel:
         For an insert (:mod:`patterns.flattening.inserts`: a wedge cut from a
         saddle-shaped panel to relieve it, sewn back into the slash it leaves):
         the name of the panel it fills.
+    gore_of : str or None
+        For a gore (:mod:`patterns.flattening.gores`: a piece of a panel split
+        along cuts from its outline to its crown, each cut a seam): the name of
+        the panel it was cut from.
     """
 
     name: str
@@ -108,6 +112,7 @@ class Panel:
     surface: Surface | None = None
     param: np.ndarray | None = None
     insert_into: str | None = None
+    gore_of: str | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "vertices", _own(self.vertices))
@@ -238,11 +243,11 @@ class Model:
 
 
 def panel_from_mesh(label: str, vertices, faces, *, name: str, cad_faces: tuple = (), surface=None,
-                    param=None, insert_into: str | None = None) -> Panel:
+                    param=None, insert_into: str | None = None, gore_of: str | None = None) -> Panel:
     """A :class:`Panel` from a disk-like mesh: validated (``name`` in messages), its loops longest first.
 
     The one way loading builds a panel, from a mesh file's piece or from CAD faces.
     """
     v, f, conn = validate_mesh(vertices, faces, name=name)
     return Panel(label, v, f, longest_first(v, conn.loops), tuple(cad_faces), surface=surface, param=param,
-                 insert_into=insert_into)
+                 insert_into=insert_into, gore_of=gore_of)

@@ -217,7 +217,7 @@ def test_a_looser_limit_takes_fewer_darts_and_too_few_darts_are_reported(hemisph
 @pytest.mark.parametrize("source, cuts", [("hemisphere", 16), ("cup", 12)])
 def test_gores_split_a_dome_into_pieces_that_each_meet_the_limit(hemisphere, source, cuts, tmp_path):
     model = hemisphere[0] if source == "hemisphere" else patterns.load(SAMPLES / "cup.step")
-    pattern = patterns.flatten(model, max_strain=LIMIT, gores=True, max_darts=cuts)
+    pattern = patterns.flatten(model, max_strain=LIMIT, gores=True, max_gores=cuts)
     gores = pattern.model
     assert len(gores.panels) > len(model.panels)
     # Nothing lost or doubled: the pieces cover the panels' 3D area exactly.

@@ -656,6 +656,7 @@ _FLAGS = {
     "--seam-allowance": _NUMBER, "--max-strain": _NUMBER, "--max-seam-mismatch": _NUMBER,
     "--notch-spacing": _NUMBER, "--bend-spacing": _NUMBER, "--text-height": _NUMBER, "--gap": _NUMBER,
     "--arc-tolerance": _NUMBER, "--dart-strain": _NUMBER, "--max-darts": st.integers(-2, 4),
+    "--max-gores": st.integers(-1, 4),
     "--max-iterations": st.integers(-2, 30), "--min-stretch": _NUMBER, "--crease-angle": _NUMBER,
     "--area-tolerance": _NUMBER, "--max-distortion": _NUMBER, "--roll-width": _NUMBER,
     "--thickness": _NUMBER, "--k-factor": _NUMBER,

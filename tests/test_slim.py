@@ -70,7 +70,8 @@ def test_reweighted_steps_carry_a_crushed_start_of_a_flat_hand_to_its_true_shape
     assert crushed_start(fr, start) and not crushed_start(fr, v[:, :2])
     sd = SymmetricDirichlet(fr)
     before = sd.terms(fr.jacobian(start))[0]
-    carried, used = reweighted(fr, start, conn.loops)
+    carried, used, blocked = reweighted(fr, start, conn.loops)
+    assert not blocked
     after = sd.terms(fr.jacobian(carried))[0]
     assert 1 <= used <= 20 and after < 1e-3 * before
     assert np.all(signed_areas(carried, f) > 0) and patterns.overlap_verdict(carried, f, conn.loops).one_to_one
@@ -82,6 +83,30 @@ def test_reweighted_steps_carry_a_crushed_start_of_a_flat_hand_to_its_true_shape
         assert result.energy == "hybrid" and np.all(signed_areas(result.uv, f) > 0)
         flat = np.linalg.norm(result.uv[e[:, 1]] - result.uv[e[:, 0]], axis=1)
         np.testing.assert_allclose(flat, edge_lengths(v, e), rtol=1e-4)
+
+
+def test_a_reweighted_step_that_would_run_the_outline_into_itself_stops_the_steps():
+    """The flat hand with two fingers, everything above the palm pressed towards the hand's middle line to
+    1e-3 of its width: the fingers lie 0.002 mm apart.  SLIM's proxy inflates each finger about itself,
+    into the other: the first step that lowers the energy crosses the outline, so the steps stop there
+    (``blocked``), the layout one-to-one and its energy no higher than the start's; ``relax`` then takes
+    the barrier path from the start (energy "arap" or the hybrid it falls back on, never a crossing)."""
+    v, f = _hand(fingers=2, length=16, width=2, palm=8)
+    v, f, conn = validate_mesh(v, f, name="hand")
+    start = v[:, :2].copy()
+    above = start[:, 1] > 80.0
+    middle = 40.0
+    start[above, 0] = middle + (start[above, 0] - middle) * 1e-3
+    fr = frames(v, f)
+    assert np.all(signed_areas(start, f) > 0) and patterns.overlap_verdict(start, f, conn.loops).one_to_one
+    assert crushed_start(fr, start)
+    sd = SymmetricDirichlet(fr)
+    carried, used, blocked = reweighted(fr, start, conn.loops)
+    assert blocked and used >= 1
+    assert np.all(signed_areas(carried, f) > 0) and patterns.overlap_verdict(carried, f, conn.loops).one_to_one
+    assert sd.terms(fr.jacobian(carried))[0] <= sd.terms(fr.jacobian(start))[0]
+    result = relax(v, f, conn, start, barrier=0.1)
+    assert np.all(signed_areas(result.uv, f) > 0) and patterns.overlap_verdict(result.uv, f, conn.loops).one_to_one
 
 
 def test_the_bundled_thin_limbed_meshes_are_the_bytes_their_readme_names():

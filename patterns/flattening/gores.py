@@ -20,6 +20,7 @@ from ..cut import cut_along, insert_line, pieces
 from ..mesh import polyline_length, unique_edges
 from ..model import Model, Seam, panel_from_mesh
 from ..pattern import Flattening
+from .curvature import gore_bound
 from .darts import dart_lines, worst_strain
 from .engine import flatten_mesh
 from .seams import held_lengths
@@ -50,26 +51,43 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
     Model
         Unchanged if the panel is within the limit or no split with 1 to
         ``max_cuts`` cuts could be made; otherwise the split that meets the
-        limit with the fewest cuts, or, if none does, the one that came
-        closest.
+        limit with the fewest cuts tried, or, if none does, the one that came
+        closest.  The counts tried start at the gore bound
+        (:func:`patterns.flattening.curvature.gore_bound`, rounded up) and go
+        up until the limit is met, or down from there while it still is.
     """
     if worst_strain(result) <= limit:
         return model
-    best = (np.inf, model)
-    for k in range(1, max_cuts + 1):  # k cuts: k pieces round a crown inside, k + 1 to a crown on the outline
-        paths = _gore_paths(result, k, limit)
-        if paths is None:
-            continue
-        split = split_panel(model, index, paths)
-        if split is None:
-            continue
-        n_pieces = len(split.panels) - len(model.panels) + 1
-        worst = max(worst_strain(flat_piece(split, p, options)) for p in range(index, index + n_pieces))
-        if worst < best[0]:
-            best = (worst, split)
-        if worst <= limit:
-            break
-    return best[1]
+    tried = {}  # cuts -> (worst piece's strain, split model), or None where the split could not be made
+
+    def attempt(k: int):
+        if k not in tried:
+            tried[k] = None
+            paths = _gore_paths(result, k, limit)
+            split = None if paths is None else split_panel(model, index, paths)
+            if split is not None:
+                n_pieces = len(split.panels) - len(model.panels) + 1
+                tried[k] = (max(worst_strain(flat_piece(split, p, options)) for p in range(index, index + n_pieces)),
+                            split)
+        return tried[k]
+
+    def met(k: int) -> bool:
+        return attempt(k) is not None and tried[k][0] <= limit
+
+    # From the gore bound (what the curvature asks for, balanced gores): up until the limit is met,
+    # or, if met there at once, down while it still is.
+    k = int(np.clip(np.ceil(gore_bound(result, limit)), 1, max_cuts))
+    if met(k):
+        while k > 1 and met(k - 1):
+            k -= 1
+    else:
+        while k < max_cuts and not met(k + 1):
+            k += 1
+    done = [v for v in tried.values() if v is not None]
+    if not done:
+        return model
+    fewest_met = min((c for c, v in tried.items() if v is not None and v[0] <= limit), default=None)
+    return tried[fewest_met][1] if fewest_met is not None else min(done, key=lambda v: v[0])[1]
 
 
 def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Model | None:
@@ -80,9 +98,10 @@ def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Mo
     place (named ``name-1``, ``name-2``, ...; panels after it move up), every
     cut becomes a seam between the two pieces it parts (appended after the
     model's seams, so seam ids stay), and the panel's seams move to the piece
-    they lie on.  With ``inserts``, the largest piece keeps the panel's name
-    and comes first, the others are its inserts (``name-insert-1``, ...,
-    :attr:`Panel.insert_into` the panel's name).  None if the cuts do not part the panel into one piece more
+    they lie on; each piece's :attr:`Panel.gore_of` is the panel's name.  With
+    ``inserts``, the largest piece keeps the panel's name and comes first, the
+    others are its inserts (``name-insert-1``, ..., :attr:`Panel.insert_into`
+    the panel's name; ``gore_of`` None).  None if the cuts do not part the panel into one piece more
     than there are cuts meeting at one point (a cut that parts nothing).
     """
     vertices, faces, cuts = paths
@@ -92,11 +111,11 @@ def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Mo
     if len(groups) < 2:
         return None
     labels = [f"{panel.name}-{j + 1}" for j in range(len(groups))]
-    into = [None] * len(groups)
+    into, of = [None] * len(groups), [panel.name] * len(groups)
     if inserts:
         groups.sort(key=len, reverse=True)
         labels = [panel.name] + [f"{panel.name}-insert-{j}" for j in range(1, len(groups))]
-        into = [None] + [panel.name] * (len(groups) - 1)
+        into, of = [None] + [panel.name] * (len(groups) - 1), [None] * len(groups)
     parts, local = [], np.full(len(cut.vertices), -1, dtype=np.int64)
     owner = np.full(len(cut.vertices), -1, dtype=np.int64)
     for j, group in enumerate(groups):
@@ -105,7 +124,8 @@ def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Mo
         local[used] = np.arange(len(used))
         owner[used] = j
         parts.append(panel_from_mesh(labels[j], cut.vertices[used], np.searchsorted(used, f),
-                                      name=f"{model.name}: panel {labels[j]}", insert_into=into[j]))
+                                      name=f"{model.name}: panel {labels[j]}", insert_into=into[j],
+                                      gore_of=of[j]))
     k = len(groups)
     renumber = np.array([p if p < index else p + k - 1 for p in range(len(model.panels))])
     seams = []

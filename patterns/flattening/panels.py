@@ -63,6 +63,12 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
           curvature, then measured, their legs sewn to equal length
           (:mod:`patterns.flattening.darts`); they are in
           :attr:`FlatPanel.darts`, the search in :attr:`FlatPanel.dart_search`;
+          a saddle-shaped panel is slashed instead, each slash's wedge an
+          insert (:mod:`patterns.flattening.inserts`, at most ``max_darts``);
+        * ``gores``, ``max_gores`` (24): with ``max_strain``, such a panel is
+          split into the fewest gores (at most ``max_gores``) that each flatten
+          within it, every cut a seam (:mod:`patterns.flattening.gores`; each
+          piece's :attr:`Panel.gore_of` names the panel it was cut from);
         * ``max_iterations`` (500), ``energy_tolerance`` (1e-6; ``flatten_mesh``:
           1e-5, a pattern is relaxed to convergence), ``min_stretch``,
           ``energy`` (``"auto"``): the relaxation, see :func:`flatten_mesh`.
@@ -154,8 +160,10 @@ def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> Mode
         held = held_lengths(model, i, vertices, {}, SeamLengths(opts.seams), mesh_edges=unique_edges(panel.faces))
         options = _engine_options(opts, name)
         result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
-        cut = gored if opts.gores else slashed
-        model = cut(model, i, result, opts.max_strain, opts.max_darts, options)
+        if opts.gores:
+            model = gored(model, i, result, opts.max_strain, opts.max_gores, options)
+        else:
+            model = slashed(model, i, result, opts.max_strain, opts.max_darts, options)
     return model
 
 

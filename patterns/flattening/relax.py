@@ -45,6 +45,9 @@ Method
   heads).  Gradient steps inflate such parts by a few per cent an iteration:
   300-400 iterations where the reweighted steps take 12-20, and the
   Laplacian-preconditioned tail after them 250-500 where this one takes 30-110.
+  SLIM's proxy does not see the outline: where a reweighted step would run it
+  into itself (libigl's camel, its legs pressed together), the steps are
+  dropped and the start takes the barrier path below instead.
 * **Pins** are reached first by stress-majorization steps cut vertex by vertex
   (:func:`_travel_to_pins`), then held while the rest relaxes.
 """
@@ -60,7 +63,7 @@ from ..mesh import Connectivity, edge_lengths
 from .embed import LDL, LDLFactor, factorize
 from .energy import ENERGIES, Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, dot, frames
 from .hessian import PairFactor, PairSystem, corner_columns, projected_hessian
-from .moves import boundary_crossings, edge_index, flip_free_steps, layout_size, safe_move
+from .moves import edge_index, flip_free_steps, layout_size, outline_valid, safe_move
 from .slim import SLIM_STEPS, crushed_start, reweighted
 
 _WINDOW = 2  # iterations over which progress is judged
@@ -189,12 +192,18 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         # A far start with crushed parts (the thin limbs of a conformal or Tutte layout): carried near by
         # reweighted steps first (:mod:`.slim`), then relaxed from there with no barrier stages.  "auto"
         # goes to the hybrid at once: ARAP's minimum crushed a triangle on every such mesh measured.
-        if energy == "auto":
-            energy = "hybrid"
         steps = min(SLIM_STEPS, max_iterations - iterations)
         pair = PairSystem(fr, n)
-        uv, used = reweighted(fr, uv, conn.loops, energy=energy, iterations=steps, system=pair)
-        iterations, barrier = iterations + used, 0.0
+        moved = reweighted(fr, uv, conn.loops, energy="hybrid" if energy == "auto" else energy, iterations=steps,
+                           system=pair)
+        iterations += moved.used
+        if moved.blocked:
+            # The steps would run the outline into itself (a camel's legs pressed together): SLIM's proxy
+            # does not see the outline, so the barrier path goes from the start instead.
+            carried, pair = False, None
+        else:
+            uv, barrier = moved.uv, 0.0
+            energy = "hybrid" if energy == "auto" else energy
     guard = InverseTerm(fr, 1.0 + 1.0 / min_stretch**2) if min_stretch else None
     system = _System(conn, fr, free, seam, seam_index, pair=pair)
     chosen = "arap" if energy == "auto" else energy
@@ -497,7 +506,7 @@ class _Minimiser:
         while step > smallest:
             cand = uv + step * direction
             new_value, new_grad, parts = self.evaluate(cand, mu)
-            if new_value <= value + 1e-4 * step * slope and boundary_crossings(cand, self.loops) is None:
+            if new_value <= value + 1e-4 * step * slope and outline_valid(cand, self.loops):
                 return True, (cand, new_value, new_grad, parts)
             step *= 0.5
         return False, None

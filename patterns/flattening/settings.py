@@ -106,11 +106,13 @@ class FlattenOptions(Options):
                                             "above this ratio (0.03 = 3 %): the fewest evenly spaced darts, as short "
                                             "as the limit allows",
                                       optional=True, unit="ratio", flag="--dart-strain")
-    max_darts: int = option(12, "at most this many darts per panel (with gores: cuts), 0..100", low=0, high=100,
-                            integer=True, metavar="N")
+    max_darts: int = option(12, "at most this many darts per panel (or slashes, on a saddle-shaped one), 0..100",
+                            low=0, high=100, integer=True, metavar="N")
     gores: bool = option(False, "with a strain limit: split a panel above it into gores along the dart lines, "
                                 "run on to the crown, each cut a seam held at its 3D length, instead of darts "
                                 "that stop short")
+    max_gores: int = option(24, "with gores: at most this many gores per panel (cuts from its outline), 1..100",
+                            low=1, high=100, integer=True, metavar="N")
     max_iterations: int = option(500, "relaxed: at most this many relaxation iterations (up to 100000)", low=0,
                                  low_open=True, high=100_000, integer=True, metavar="N")
     energy_tolerance: float = option(1e-6, "relaxed: stop when the energy falls by less than this fraction per "

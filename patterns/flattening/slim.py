@@ -28,13 +28,15 @@ from its layout.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .energy import Arap, Frames, Hybrid, SymmetricDirichlet
 from .hessian import PairSystem, corner_columns
-from .moves import boundary_crossings, flip_free_steps, layout_size
+from .moves import flip_free_steps, layout_size, outline_valid
 
-__all__ = ["CRUSHED_START", "SLIM_STEPS", "crushed_start", "reweighted"]
+__all__ = ["CRUSHED_START", "SLIM_STEPS", "Carried", "crushed_start", "reweighted"]
 
 CRUSHED_START = 1e-2
 """A start is carried by :func:`reweighted` first when 1 % of its area (3D) is squeezed below this stretch.
@@ -42,7 +44,9 @@ CRUSHED_START = 1e-2
 (1e-3 at first; the five OptCuts starts between 1e-3 and 1e-2 -- chinese lion, evil, foot,
 gargoyle, vase -- all ended in the hybrid by the other path too, and carried they took 0.5-0.9
 of its time at a lower energy.  The lowest start measured whose ARAP minimum crushes nothing,
-the BFF spot head, is at 1.5e-2.)"""
+the BFF spot head, is at 1.5e-2.  libigl's camel (``camel_b``, 5.5e-3) is carried too, but its
+legs press together: the first reweighted step runs its outline into itself, and the relaxation
+then goes the barrier path from the start instead, see :attr:`Carried.blocked`.)"""
 
 SLIM_STEPS = 20
 """Reweighted steps :func:`patterns.flattening.relax.relax` takes at most from a crushed start (SLIM's usual count)."""
@@ -91,8 +95,20 @@ def _proxy(jac, stretch: tuple[float, float]):
     return weight, target
 
 
+class Carried(NamedTuple):
+    """What :func:`reweighted` returns."""
+
+    uv: np.ndarray
+    """(n, 2) float64: one-to-one, its energy no higher than the start's."""
+    used: int
+    """Steps taken."""
+    blocked: bool
+    """A step that lowered the energy would have run the outline into itself (SLIM's proxy knows
+    nothing of the outline): stopped there, the layout as it was before that step."""
+
+
 def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-dirichlet",
-               iterations: int = SLIM_STEPS, system: PairSystem | None = None) -> tuple[np.ndarray, int]:
+               iterations: int = SLIM_STEPS, system: PairSystem | None = None) -> Carried:
     """Carry a one-to-one layout towards least distortion by SLIM's reweighted steps.
 
     Parameters
@@ -112,10 +128,8 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
 
     Returns
     -------
-    uv : (n, 2) float64
-        One-to-one, its energy no higher than the start's.
-    used : int
-        Steps taken.
+    Carried
+        ``(uv, used, blocked)``.
     """
     n = len(uv)
     system = PairSystem(fr, n) if system is None else system
@@ -145,13 +159,15 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
             cand = uv + step * direction
             cand_jac = fr.jacobian(cand)
             terms = energy.terms(cand_jac)
-            if terms is not None and terms[0] < value and boundary_crossings(cand, loops) is None:
+            if terms is not None and terms[0] < value:
+                if not outline_valid(cand, loops):
+                    return Carried(uv, used, True)  # the step would run the outline into itself
                 break
             step *= 0.5
         else:
-            return uv, used
+            return Carried(uv, used, False)
         gain = (value - terms[0]) / value
         uv, value, jac = cand, terms[0], cand_jac
         if gain < _TOLERANCE:
             break
-    return uv, used
+    return Carried(uv, used, False)
