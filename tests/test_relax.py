@@ -383,3 +383,32 @@ def test_one_surface_meshed_three_ways_gives_one_strain():
     bound = np.sqrt(quad(lambda p: (p / np.sin(p) - 1) ** 2 * np.sin(p), 1e-12, a)[0]
                     / (2 * quad(np.sin, 0, a)[0]))  # 1.90 %
     assert all(x < bound for x in rms)
+
+
+def test_the_relaxation_stops_once_the_strain_is_immaterial_and_not_before():
+    """A cylinder patch's exact layout shaken by 3e-10 of its size (RMS strain about 1e-8, below the 1e-7 at
+    which it stops: 1e-14 per triangle) is taken one step and handed back; shaken by 3e-7 (RMS strain
+    about 1e-5), it is relaxed on, to within the 1e-7 (area-weighted RMS of the principal strains)."""
+    from patterns.flattening.relax import relax
+    from patterns.measure import triangle_strains
+
+    v, f = surfaces.cylinder_patch(radius=200.0, height=300.0, angle=90.0)
+    v, f, conn = validate_mesh(v, f, name="cylinder")
+    exact = patterns.flatten_mesh(v, f).uv
+    rng = np.random.default_rng(11)
+    noise = rng.normal(size=exact.shape)
+    for shake, steps in ((3e-10, 1), (3e-7, None)):
+        start = exact + shake * float(np.ptp(exact)) * noise
+        before = _rms(triangle_strains(v, f, start))
+        result = relax(v, f, conn, start, barrier=0.0, tolerance=1e-5)
+        rms = _rms(triangle_strains(v, f, result.uv))
+        assert rms < 1e-7 and result.converged
+        if steps is None:
+            assert before > 1e-6 and result.iterations > 1
+        else:
+            assert 1e-9 < before < 1e-7 and result.iterations == steps
+
+
+def _rms(strains) -> float:
+    """Area-weighted RMS of both principal strains."""
+    return float(np.sqrt(np.sum(strains.area_3d[:, None] * strains.strain ** 2) / (2 * strains.area_3d.sum())))
