@@ -5,7 +5,7 @@ import pytest
 import scipy.sparse as sp
 
 from patterns.flattening.energy import Arap, Hybrid, Jacobian, SymmetricDirichlet, frames
-from patterns.flattening.hessian import PairSystem, corner_columns, projected_hessian
+from patterns.flattening.hessian import PAIRS, PairSystem, corner_columns, projected_hessian
 from patterns.mesh import validate_mesh
 from patterns.surfaces import spherical_cap
 
@@ -83,6 +83,14 @@ def test_a_pair_systems_laplacian_and_blocks_land_where_they_belong():
     reference = sp.kron(sp.eye(2), graph).toarray()
     np.testing.assert_allclose(system.matrix(system.laplacian(conn.edges, w)).toarray(), reference, atol=1e-12)
     blocks = projected_hessian(fr, fr.jacobian(1.1 * v[:, :2]), Hybrid.stretch)
+    packed = projected_hessian(fr, fr.jacobian(1.1 * v[:, :2]), Hybrid.stretch, packed=True)
+    np.testing.assert_allclose(packed, blocks[:, PAIRS[:, 0], PAIRS[:, 1]], rtol=1e-12, atol=1e-12 * np.abs(blocks).max())
+    np.testing.assert_allclose(system.assemble(packed), system.assemble(blocks), rtol=1e-12, atol=1e-12)
+    dense = np.zeros((2 * n, 2 * n))  # the blocks scattered by hand, each triangle's unknowns (u0, u1, u2, v0, v1, v2)
+    for block, (a, b, c) in zip(blocks, f):
+        idx = np.array([a, b, c, a + n, b + n, c + n])
+        dense[np.ix_(idx, idx)] += block
+    np.testing.assert_allclose(system.matrix(system.assemble(blocks)).toarray(), dense, atol=1e-12 * np.abs(dense).max())
     values = system.assemble(blocks) + system.laplacian(conn.edges, w)
     values[system.diagonal[[0, n]]] += 1.0  # vertex 0 held: neither part sees a translation
     b = rng.normal(size=(n, 2))

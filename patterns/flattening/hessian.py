@@ -24,7 +24,11 @@ import scipy.sparse as sp
 from .embed import LDL, LDLFactor
 from .energy import Frames, Jacobian
 
-__all__ = ["PairFactor", "PairSystem", "corner_columns", "projected_hessian"]
+__all__ = ["PAIRS", "PairFactor", "PairSystem", "corner_columns", "projected_hessian"]
+
+
+PAIRS = np.array([(a, b) for a in range(6) for b in range(a, 6)], dtype=np.int64)
+"""``(21, 2)``: the entries ``(a, b)``, ``a <= b``, of a triangle's symmetric 6 x 6 block, in packed order."""
 
 
 def corner_columns(fr: Frames) -> np.ndarray:
@@ -34,7 +38,7 @@ def corner_columns(fr: Frames) -> np.ndarray:
 
 
 def projected_hessian(fr: Frames, jac: Jacobian, stretch: tuple[float, float], *,
-                      columns: np.ndarray | None = None) -> np.ndarray:
+                      columns: np.ndarray | None = None, packed: bool = False) -> np.ndarray:
     """Every triangle's Hessian of ``W_t (f(sigma1) + f(sigma2))``, its negative eigenvalue clamped at 0.
 
     Parameters
@@ -46,10 +50,12 @@ def projected_hessian(fr: Frames, jac: Jacobian, stretch: tuple[float, float], *
         ``(p, q)`` of ``f`` (an energy's ``stretch``).
     columns : (m, 3, 2) float64, optional
         :func:`corner_columns`, if at hand.
+    packed : bool
+        Return each block's 21 entries ``(a, b)``, ``a <= b``, in the order of :data:`PAIRS`.
 
     Returns
     -------
-    (m, 6, 6) float64
+    (m, 6, 6) float64, or (m, 21) packed
         In the corner order ``(u0, u1, u2, v0, v1, v2)``; positive semidefinite.
     """
     p, q = stretch
@@ -79,7 +85,14 @@ def projected_hessian(fr: Frames, jac: Jacobian, stretch: tuple[float, float], *
     b0, b1 = -su[:, None] * cv1, cu[:, None] * cv1  # u2 (x) C v1
     g[:, 2, :3], g[:, 2, 3:] = root[2][:, None] * (a0 - b0), root[2][:, None] * (a1 - b1)
     g[:, 3, :3], g[:, 3, 3:] = root[3][:, None] * (a0 + b0), root[3][:, None] * (a1 + b1)
-    return np.matmul(g.transpose(0, 2, 1), g)
+    if not packed:
+        return np.matmul(g.transpose(0, 2, 1), g)
+    by_entry = np.ascontiguousarray(g.transpose(2, 1, 0))  # (6, 4, m): 21 products of rows, not a 6 x 6 matmul
+    out = np.empty((len(w), len(PAIRS)))
+    for k, (a, b) in enumerate(PAIRS):
+        x = by_entry[a] * by_entry[b]
+        out[:, k] = x[0] + x[1] + x[2] + x[3]
+    return out
 
 
 class PairSystem:
@@ -95,17 +108,21 @@ class PairSystem:
     def __init__(self, fr: Frames, n: int):
         corners = np.column_stack(fr.corners)  # (m, 3)
         self.local = np.hstack([corners, corners + n])  # (m, 6): a triangle's unknowns
-        rows, cols = np.repeat(self.local, 6, axis=1), np.tile(self.local, (1, 6))  # (m, 36): entry (a, b) at 6 a + b
-        self.upper = rows <= cols
-        self._keys, self.slot = np.unique(rows[self.upper] * (2 * n) + cols[self.upper], return_inverse=True)
+        a, b = self.local[:, PAIRS[:, 0]], self.local[:, PAIRS[:, 1]]  # (m, 21): each entry's two unknowns
+        self._keys, slot = np.unique(np.minimum(a, b) * (2 * n) + np.maximum(a, b), return_inverse=True)
+        self._slot = slot.reshape(a.shape)
         self.n, self.n_entries = n, len(self._keys)
         self.diagonal = np.flatnonzero(self._keys // (2 * n) == self._keys % (2 * n))  # (2 n,): unknown by unknown
         self._ldl = LDL(2 * n, self._keys // (2 * n), self._keys % (2 * n))
 
     def assemble(self, blocks: np.ndarray) -> np.ndarray:
-        """The upper-triangle values ``(k,)`` of the sum of the triangles' ``(m, 6, 6)`` blocks."""
-        flat = blocks.reshape(len(blocks), 36)
-        return np.bincount(self.slot, weights=flat[self.upper], minlength=self.n_entries)
+        """The upper-triangle values ``(k,)`` of the sum of the triangles' blocks.
+
+        ``blocks`` is ``(m, 6, 6)``, or ``(m, 21)`` packed: entry ``(a, b)``, ``a <= b``, of each block
+        in the order of :data:`PAIRS`.
+        """
+        packed = blocks if blocks.ndim == 2 else blocks[:, PAIRS[:, 0], PAIRS[:, 1]]
+        return np.bincount(self._slot.ravel(), weights=packed.ravel(), minlength=self.n_entries)
 
     def laplacian(self, edges: np.ndarray, weight: np.ndarray) -> np.ndarray:
         """Values ``(k,)`` of ``L (x) I``, ``L`` the graph Laplacian of mesh ``edges`` ``(e, 2)`` with ``weight`` ``(e,)``."""

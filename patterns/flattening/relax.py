@@ -342,7 +342,7 @@ class _System:
     def hessian(self, u: np.ndarray, main) -> PairFactor:
         """The projected Hessian of ``main`` at ``u`` plus the seam stiffness, factorised (``pair`` given)."""
         values = self.pair.assemble(projected_hessian(self.fr, self.fr.jacobian(u), main.stretch,
-                                                      columns=self._columns))
+                                                      columns=self._columns, packed=True))
         if self.extra.any():
             values += self.pair.laplacian(self.conn.edges, self.extra)
         values[self.pair.diagonal] += _PROXIMAL * float(values[self.pair.diagonal].mean())

@@ -33,7 +33,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .energy import Arap, Frames, Hybrid, SymmetricDirichlet
-from .hessian import PairSystem, corner_columns
+from .hessian import PAIRS, PairSystem, corner_columns
 from .moves import flip_free_steps, layout_size, outline_valid
 
 __all__ = ["CRUSHED_START", "SLIM_STEPS", "Carried", "crushed_start", "reweighted"]
@@ -143,7 +143,8 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
     used = 0
     for used in range(1, iterations + 1):
         weight, target = _proxy(jac, energy.stretch)
-        values = system.assemble(weight[:, :, None, :, None] * stiff[:, None, :, None, :])  # (k, c) x (l, c')
+        # Entry ((k, c), (l, c')) of W A^2 (x) C C^T, packed (hessian.PAIRS: unknown k * 3 + c).
+        values = system.assemble(weight[:, PAIRS[:, 0] // 3, PAIRS[:, 1] // 3] * stiff[:, PAIRS[:, 0] % 3, PAIRS[:, 1] % 3])
         proximal = 1e-9 * float(values[system.diagonal].mean())  # holds the translation; biases nothing else
         values[system.diagonal] += proximal
         # Right-hand side: each triangle's W (A^2 R) C^T, scattered to its corners.
