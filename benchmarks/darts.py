@@ -18,8 +18,8 @@ a single-panel flattening with no limit; there is no open dart tool to race).
 Then (``--shapes``, issue 36) the curved faces of ``patterns.samples.DOMES``
 (a spline bowl, oblate and prolate domes, an ellipsoid, a torus patch, a
 saddle, an asymmetric freeform cup), each with darts (inserts on the saddle)
-and then in gores: the worst and RMS strain, the darts' total 3D length or the
-gore count, whether the
+and then in gores (at most ``max_gores``, 24, the default): the worst and RMS strain, the darts'
+total 3D length or the gore count, whether the
 limit was met, the largest difference between the two flat sides of a gore
 seam, and the time against the dartless flattening.
 
