@@ -52,7 +52,7 @@ import scipy.sparse as sp
 
 from ..measure import local_coordinates
 
-__all__ = ["ENERGIES", "Arap", "EdgeLengths", "Frames", "Hybrid", "InverseTerm", "Jacobian", "SymmetricDirichlet",
+__all__ = ["BY_NAME", "ENERGIES", "Arap", "EdgeLengths", "Frames", "Hybrid", "InverseTerm", "Jacobian", "SymmetricDirichlet",
            "dot", "frames"]
 
 
@@ -312,7 +312,7 @@ class Hybrid(_TriangleEnergy):
         if sd is None:
             return None
         arap = self._arap.terms(jac)
-        a, b = 1.0 - self.share, 0.25 * self.share
+        a, b = self.stretch
         return a * arap[0] + b * sd[0], tuple(a * x + b * y for x, y in zip(arap[1], sd[1]))
 
 
@@ -418,3 +418,7 @@ class EdgeLengths:
         """The term's curvature along each edge if each were its own group, ``W rho / T**2`` (the preconditioner's)."""
         w = self.weight[self.group] / np.bincount(self.group, minlength=len(self.weight))[self.group]
         return w * self.rho / (self.target * self.target)
+
+
+BY_NAME = {"arap": Arap, "hybrid": Hybrid, "symmetric-dirichlet": SymmetricDirichlet}
+"""The distortion energies by their ``name`` (every one of :data:`ENERGIES` but ``"auto"``)."""

@@ -83,11 +83,11 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
     else:
         while k < max_cuts and not met(k + 1):
             k += 1
-    done = [v for v in tried.values() if v is not None]
-    if not done:
-        return model
-    fewest_met = min((c for c, v in tried.items() if v is not None and v[0] <= limit), default=None)
-    return tried[fewest_met][1] if fewest_met is not None else min(done, key=lambda v: v[0])[1]
+    done = {c: v for c, v in tried.items() if v is not None}
+    passing = [c for c, v in done.items() if v[0] <= limit]
+    if passing:
+        return done[min(passing)][1]
+    return min(done.values(), key=lambda v: v[0])[1] if done else model
 
 
 def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Model | None:

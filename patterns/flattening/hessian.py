@@ -103,9 +103,15 @@ class PairSystem:
     fr : Frames
     n : int
         Vertices.
+
+    Attributes
+    ----------
+    columns : (m, 3, 2) float64
+        The mesh's :func:`corner_columns`, for the blocks that go into it.
     """
 
     def __init__(self, fr: Frames, n: int):
+        self.columns = corner_columns(fr)
         corners = np.column_stack(fr.corners)  # (m, 3)
         self.local = np.hstack([corners, corners + n])  # (m, 6): a triangle's unknowns
         a, b = self.local[:, PAIRS[:, 0]], self.local[:, PAIRS[:, 1]]  # (m, 21): each entry's two unknowns

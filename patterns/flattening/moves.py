@@ -168,8 +168,7 @@ def outline_valid(uv: np.ndarray, loops) -> bool:
 def boundary_crossings(uv: np.ndarray, loops):
     """None when the flat loops form a valid polygon; else the vertices of the
     boundary segments that cross another one (possibly empty)."""
-    rings = [uv[loop] for loop in loops]
-    if shapely.is_valid(shapely.Polygon(rings[0], rings[1:])):
+    if outline_valid(uv, loops):
         return None
     _, pair, i, j = crossing_segments(uv, loops)
     return np.unique(np.concatenate([pair[i].ravel(), pair[j].ravel()]))

@@ -61,8 +61,8 @@ import scipy.sparse as sp
 
 from ..mesh import Connectivity, edge_lengths
 from .embed import LDL, LDLFactor, factorize
-from .energy import ENERGIES, Arap, EdgeLengths, Hybrid, InverseTerm, SymmetricDirichlet, dot, frames
-from .hessian import PairFactor, PairSystem, corner_columns, projected_hessian
+from .energy import BY_NAME, ENERGIES, Arap, EdgeLengths, Hybrid, InverseTerm, dot, frames
+from .hessian import PairFactor, PairSystem, projected_hessian
 from .moves import edge_index, flip_free_steps, layout_size, outline_valid, safe_move
 from .slim import SLIM_STEPS, crushed_start, reweighted
 
@@ -199,20 +199,19 @@ def relax(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, start: np
         # goes to the hybrid at once: ARAP's minimum crushed a triangle on every such mesh measured.
         steps = min(SLIM_STEPS, max_iterations - iterations)
         pair = PairSystem(fr, n)
-        moved = reweighted(fr, uv, conn.loops, energy="hybrid" if energy == "auto" else energy, iterations=steps,
-                           system=pair)
+        far = "hybrid" if energy == "auto" else energy
+        moved = reweighted(fr, uv, conn.loops, energy=far, iterations=steps, system=pair)
         iterations += moved.used
         if moved.blocked:
             # The steps would run the outline into itself (a camel's legs pressed together): SLIM's proxy
             # does not see the outline, so the barrier path goes from the start instead.
             carried, pair = False, None
         else:
-            uv, barrier = moved.uv, 0.0
-            energy = "hybrid" if energy == "auto" else energy
+            uv, barrier, energy = moved.uv, 0.0, far
     guard = InverseTerm(fr, 1.0 + 1.0 / min_stretch**2) if min_stretch else None
     system = _System(conn, fr, free, seam, seam_index, pair=pair)
     chosen = "arap" if energy == "auto" else energy
-    main = {"arap": Arap, "hybrid": Hybrid, "symmetric-dirichlet": SymmetricDirichlet}[chosen](fr)
+    main = BY_NAME[chosen](fr)
     converged = False
     # "auto" from a far start: a first, looser ARAP run tells whether ARAP crushes
     # triangles (then the hybrid goes on from there) before it is run to the end.
@@ -324,7 +323,6 @@ class _System:
 
     def __init__(self, conn, fr, free, seam, seam_index, *, pair: PairSystem | None = None):
         self.conn, self.fr, self.free, self.pair = conn, fr, free, pair
-        self._columns = None if pair is None else corner_columns(fr)
         self.extra = np.zeros(len(conn.edges))
         if seam is not None:
             np.add.at(self.extra, seam_index, seam.edge_weights())
@@ -342,7 +340,7 @@ class _System:
     def hessian(self, u: np.ndarray, main) -> PairFactor:
         """The projected Hessian of ``main`` at ``u`` plus the seam stiffness, factorised (``pair`` given)."""
         values = self.pair.assemble(projected_hessian(self.fr, self.fr.jacobian(u), main.stretch,
-                                                      columns=self._columns, packed=True))
+                                                      columns=self.pair.columns, packed=True))
         if self.extra.any():
             values += self.pair.laplacian(self.conn.edges, self.extra)
         values[self.pair.diagonal] += _PROXIMAL * float(values[self.pair.diagonal].mean())

@@ -32,8 +32,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .energy import Arap, Frames, Hybrid, SymmetricDirichlet
-from .hessian import PAIRS, PairSystem, corner_columns
+from .energy import BY_NAME, Frames
+from .hessian import PAIRS, PairSystem
 from .moves import flip_free_steps, layout_size, outline_valid
 
 __all__ = ["CRUSHED_START", "SLIM_STEPS", "Carried", "crushed_start", "reweighted"]
@@ -133,9 +133,9 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
     """
     n = len(uv)
     system = PairSystem(fr, n) if system is None else system
-    c = corner_columns(fr)
+    c = system.columns
     stiff = _stiffness(fr, c)
-    energy = {"arap": Arap, "hybrid": Hybrid, "symmetric-dirichlet": SymmetricDirichlet}[energy](fr)
+    energy = BY_NAME[energy](fr)
     uv = np.array(uv, dtype=np.float64)
     jac = fr.jacobian(uv)
     value = energy.terms(jac)[0]
