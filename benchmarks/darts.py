@@ -17,13 +17,16 @@ a single-panel flattening with no limit; there is no open dart tool to race).
 
 Then (``--shapes``, issue 36) the curved faces of ``patterns.samples.DOMES``
 (a spline bowl, oblate and prolate domes, an ellipsoid, a torus patch, a
-saddle, an asymmetric freeform cup), each with darts (inserts on the saddle)
-and then in gores (at most ``max_gores``, 24, the default): the worst and RMS strain, the darts'
-total 3D length or the gore count, whether the
-limit was met, the largest difference between the two flat sides of a gore
-seam, and the time against the dartless flattening.
+saddle, an asymmetric freeform cup and bag), each three ways: darts on the one
+panel only (``max_gores=0``; inserts on the saddle); as ``flatten(max_strain=...)``
+does by default (darts, and where they fall short the panel parted into pieces
+with darts, or else gores: ``patterns.flattening.parted``); in gores (at most
+``max_gores``, 24). Columns: the worst and RMS strain, the darts' total 3D
+length or the piece count, whether the limit was met, the largest difference
+between the two flat sides of a seam the limit cut, and the time against the
+dartless flattening.
 
-    python benchmarks/darts.py [--limit 0.03] [--shapes]
+    python benchmarks/darts.py [--limit 0.03] [--shapes [--shape NAME ...]]
 """
 
 from __future__ import annotations
@@ -78,11 +81,13 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--limit", type=float, default=0.03)
     parser.add_argument("--shapes", action="store_true", help="the curved faces of patterns.samples.DOMES")
+    parser.add_argument("--shape", action="append", choices=list(samples.DOMES),
+                        help="with --shapes: only this face (repeatable)")
     args = parser.parse_args(argv)
     limit = args.limit
     print(f"strain limit {limit:.1%}\n")
     if args.shapes:
-        return shapes(limit)
+        return shapes(limit, args.shape)
     print("| dome | triangles | worst, no darts | darts | worst | RMS | dart length / gore bound "
           "| legs differ by | time | / dartless | / libigl ARAP |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
@@ -118,35 +123,52 @@ def _bound(result, limit: float) -> str:
     return f"{curvature_bound(result, limit):.1f}"
 
 
-def shapes(limit: float) -> int:
-    """The table of docs/garments.md "On other curved shapes"."""
-    print("| shape | triangles | worst, no darts | gore bound | darts | worst | RMS | dart length | met | time "
-          "| / dartless | up to 24 darts | gores | worst | gore sides differ by | met | time |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---|---:|---:|---:|---|---:|")
+def _cuts(pattern) -> str:
+    """What the strain limit cut: darts (per piece where the panel was parted), inserts, or gores."""
+    inserts = sum(p.panel.insert_into is not None for p in pattern.panels)
+    darts = [len(p.darts) for p in pattern.panels if p.panel.insert_into is None]
+    with_inserts = f"{inserts} insert{'' if inserts == 1 else 's'}" if inserts else ""
+    if len(darts) == 1:
+        return with_inserts or f"{darts[0]}"
+    kind = f"pieces: {' + '.join(map(str, darts))}" if any(darts) else "pieces" if inserts else "gores"
+    return f"{len(darts)} {kind}" + (f", {with_inserts}" if inserts else "")
+
+
+def _sides(pattern, model) -> float:
+    """The largest difference between the two flat sides of a seam the limit cut, mm."""
+    new = pattern.seams[len(model.seams):]
+    return max((abs(fs.flat_lengths[0] - fs.flat_lengths[1]) for fs in new), default=0.0)
+
+
+def shapes(limit: float, only=None) -> int:
+    """The table of docs/garments.md "On other curved shapes": each face with darts on the one panel only
+    (``max_gores=0``), as ``flatten(max_strain=...)`` does by default (parted into pieces with darts, or
+    gores, where darts alone fall short), and in gores."""
+    print("| shape | triangles | worst, no darts | gore bound | darts, one panel | worst | time "
+          "| default: cut | worst | RMS | dart length | sides differ by | met | time | / dartless "
+          "| gores | worst | sides differ by | met | time |")
+    print("|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---|---:|")
     for name, make in samples.DOMES.items():
+        if only and name not in only:
+            continue
         model = patterns.load(make())
         plain, t_plain = timed(partial(patterns.flatten, model))
+        alone, t_alone = timed(partial(patterns.flatten, model, max_strain=limit, max_gores=0))
         darted, t_darts = timed(partial(patterns.flatten, model, max_strain=limit))
         gored, t_gores = timed(partial(patterns.flatten, model, max_strain=limit, gores=True))
         darts = [d for p in darted.panels for d in p.darts]
-        inserts = sum(p.panel.insert_into is not None for p in darted.panels)
         rms = max(strain_rms(p.vertices, p.faces, p.uv) for p in darted.panels)
         after, in_gores = worst_of(darted), worst_of(gored)
         bound = max(_bound(p.flattening, limit) for p in plain.panels)
-        more = "-"
-        if after > limit:  # how many darts it takes where 12 are too few
-            many, t_many = timed(partial(patterns.flatten, model, max_strain=limit, max_darts=24))
-            n_many = sum(len(p.darts) for p in many.panels)
-            more = f"{n_many} dart{'' if n_many == 1 else 's'}, {worst_of(many):.2%}, {t_many:.0f} s"
-        new = gored.seams[len(model.seams):]
-        sides = max((abs(fs.flat_lengths[0] - fs.flat_lengths[1]) for fs in new), default=0.0)
         n = sum(len(p.faces) for p in model.panels)
-        cuts = f"{inserts} insert{'' if inserts == 1 else 's'}" if inserts else f"{len(darts)}"
-        print(f"| {name} | {n:,} | {worst_of(plain):.1%} | {bound} | {cuts} | {after:.2%} | {rms:.2%} "
-              f"| {sum(d.length_3d for d in darts):,.0f} mm | {'yes' if after <= limit else 'no'} | {t_darts:.1f} s "
-              f"| {t_darts / t_plain:.0f} x | {more} | {len(gored.panels)} | {in_gores:.2%} | {sides:.3f} mm "
+        print(f"| {name} | {n:,} | {worst_of(plain):.1%} | {bound} | {_cuts(alone)} | {worst_of(alone):.2%} "
+              f"| {t_alone:.1f} s | {_cuts(darted)} | {after:.2%} | {rms:.2%} "
+              f"| {sum(d.length_3d for d in darts):,.0f} mm | {_sides(darted, model):.3f} mm "
+              f"| {'yes' if after <= limit else 'no'} | {t_darts:.1f} s | {t_darts / t_plain:.0f} x "
+              f"| {len(gored.panels)} | {in_gores:.2%} | {_sides(gored, model):.3f} mm "
               f"| {'yes' if in_gores <= limit else 'no'} | {t_gores:.1f} s |", flush=True)
     return 0
+
 
 if __name__ == "__main__":
     sys.exit(main())

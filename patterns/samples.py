@@ -53,6 +53,8 @@ each one build123d face:
   grid of points, 160 x 120 mm and 40 mm deep, its deepest point off centre;
   ``freeform_bag`` -- the same depth pressed into a flat sheet (a 5 x 5 grid
   whose outer ring is flat).
+* ``seat`` -- a dome beside a saddle-shaped waist, one B-spline face through a
+  13 x 9 grid, 300 x 200 mm: partly positive, partly negative curvature.
 """
 
 from __future__ import annotations
@@ -62,7 +64,7 @@ from math import pi
 import numpy as np
 
 __all__ = ["DOMES", "SAMPLES", "bowl_segment", "cup", "duct_transition", "ellipsoid_cap", "freeform_bag", "freeform_cup", "hopper",
-           "hull_panel", "oblate_dome", "prolate_dome", "rolled_cylinder", "saddle", "sphere_gores", "spline_bowl",
+           "hull_panel", "oblate_dome", "prolate_dome", "rolled_cylinder", "saddle", "seat", "sphere_gores", "spline_bowl",
            "square_to_round", "torus_patch"]
 
 
@@ -267,6 +269,22 @@ def freeform_bag():
     return bd.Face.make_surface_from_array_of_points(points)
 
 
+def seat():
+    """A seat: a dome towards +x beside a saddle-shaped waist towards -x, one B-spline face through a 13 x 9
+    grid, 300 x 200 mm (the dome 40 mm high; the waist rises along x and falls across it)."""
+    import build123d as bd
+
+    xs, ys = np.linspace(-150.0, 150.0, 13), np.linspace(-100.0, 100.0, 9)
+
+    def z(x, y):
+        dome = 40.0 * np.exp(-((x - 70.0) ** 2 + y ** 2) / 60.0 ** 2)
+        waist = ((x + 70.0) ** 2 - y ** 2) / 300.0 * np.exp(-((x + 70.0) ** 2 + y ** 2) / 90.0 ** 2)
+        return dome + waist
+
+    points = [[(x, y, float(z(x, y))) for x in xs] for y in ys]
+    return bd.Face.make_surface_from_array_of_points(points)
+
+
 DOMES = {
     "spline bowl": spline_bowl,
     "oblate dome": oblate_dome,
@@ -276,6 +294,7 @@ DOMES = {
     "saddle": saddle,
     "freeform cup": freeform_cup,
     "freeform bag": freeform_bag,
+    "seat": seat,
 }
 """The curved faces of the dart and gore benchmark, by name (each function returns one face)."""
 

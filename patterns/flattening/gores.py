@@ -16,20 +16,34 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from ..cut import cut_along, insert_line, pieces
-from ..mesh import polyline_length, unique_edges
-from ..model import Model, Seam, panel_from_mesh
+from ..cut import insert_line
+from ..mesh import unique_edges
+from ..model import Model
 from ..pattern import Flattening
 from .curvature import gore_bound
 from .darts import dart_lines, worst_strain
-from .engine import flatten_mesh
-from .seams import held_lengths
+from .inserts import relieved
+from .split import FlatPiece, split_panel
 
-__all__ = ["flat_piece", "gored", "split_panel"]
+__all__ = ["gore_paths", "gore_search", "gored"]
 
 
-def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, options: dict) -> Model:
+def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, flat: FlatPiece, *,
+          max_slashes: int = 0) -> Model:
     """The model with panel ``index`` split into the fewest gores that each flatten within ``limit``.
+
+    What :func:`gore_search` found (see there), or the model unchanged where
+    the panel is within the limit or no split could be made.
+    """
+    if worst_strain(result) <= limit:
+        return model
+    found = gore_search(model, index, result, limit, max_cuts, flat, max_slashes=max_slashes)
+    return model if found is None else found[1]
+
+
+def gore_search(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, flat: FlatPiece, *,
+                max_slashes: int = 0):
+    """``(worst gore's strain, split model)``: panel ``index`` split into the fewest gores within ``limit``.
 
     Parameters
     ----------
@@ -43,32 +57,34 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
     max_cuts : int
         At most this many cuts (as many pieces round a crown inside the
         panel, one more to a crown on its outline).
-    options : dict
-        Keywords of :func:`flatten_mesh` (``name`` included).
+    flat : callable
+        ``flat(model, p) -> (Flattening, held, options)``: a gore flattened as
+        :func:`patterns.flatten` flattens it (:data:`patterns.flattening.split.FlatPiece`).
+    max_slashes : int
+        A gore above the limit that is saddle-shaped (a seat's waist) is
+        slashed and given inserts, at most this many slashes
+        (:func:`patterns.flattening.inserts.relieved`); 0: none.
 
     Returns
     -------
-    Model
-        Unchanged if the panel is within the limit or no split with 1 to
-        ``max_cuts`` cuts could be made; otherwise the split that meets the
-        limit with the fewest cuts tried, or, if none does, the one that came
-        closest.  The counts tried start at the gore bound
+    (float, Model) or None
+        None if no split with 1 to ``max_cuts`` cuts could be made; otherwise
+        the split that meets the limit with the fewest cuts tried, or, if none
+        does, the one that came closest, and its worst gore's strain.  The counts tried start at the gore bound
         (:func:`patterns.flattening.curvature.gore_bound`, rounded up) and go
         up until the limit is met, or down from there while it still is.
     """
-    if worst_strain(result) <= limit:
-        return model
     tried = {}  # cuts -> (worst piece's strain, split model), or None where the split could not be made
 
     def attempt(k: int):
         if k not in tried:
             tried[k] = None
-            paths = _gore_paths(result, k, limit)
+            paths = gore_paths(result, k, limit)
             split = None if paths is None else split_panel(model, index, paths)
             if split is not None:
                 n_pieces = len(split.panels) - len(model.panels) + 1
-                tried[k] = (max(worst_strain(flat_piece(split, p, options)) for p in range(index, index + n_pieces)),
-                            split)
+                worst, split, _ = relieved(split, index, n_pieces, limit, flat, max_slashes=max_slashes)
+                tried[k] = (worst, split)
         return tried[k]
 
     def met(k: int) -> bool:
@@ -86,77 +102,11 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
     done = {c: v for c, v in tried.items() if v is not None}
     passing = [c for c, v in done.items() if v[0] <= limit]
     if passing:
-        return done[min(passing)][1]
-    return min(done.values(), key=lambda v: v[0])[1] if done else model
+        return done[min(passing)]
+    return min(done.values(), key=lambda v: v[0]) if done else None
 
 
-def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Model | None:
-    """Cut panel ``index`` along ``paths`` (vertex paths joined by its edges, after :func:`insert_line`) into pieces.
-
-    ``paths`` are given on the panel mesh with the lines already put in
-    (``paths = (vertices, faces, [path, ...])``).  The pieces take the panel's
-    place (named ``name-1``, ``name-2``, ...; panels after it move up), every
-    cut becomes a seam between the two pieces it parts (appended after the
-    model's seams, so seam ids stay), and the panel's seams move to the piece
-    they lie on; each piece's :attr:`Panel.gore_of` is the panel's name.  With
-    ``inserts``, the largest piece keeps the panel's name and comes first, the
-    others are its inserts (``name-insert-1``, ..., :attr:`Panel.insert_into`
-    the panel's name; ``gore_of`` None).  None if the cuts do not part the panel into one piece more
-    than there are cuts meeting at one point (a cut that parts nothing).
-    """
-    vertices, faces, cuts = paths
-    panel = model.panels[index]
-    cut = cut_along(vertices, faces, cuts, name=panel.name)
-    groups = pieces(cut.faces, len(cut.vertices), name=panel.name)
-    if len(groups) < 2:
-        return None
-    labels = [f"{panel.name}-{j + 1}" for j in range(len(groups))]
-    into, of = [None] * len(groups), [panel.name] * len(groups)
-    if inserts:
-        groups.sort(key=len, reverse=True)
-        labels = [panel.name] + [f"{panel.name}-insert-{j}" for j in range(1, len(groups))]
-        into, of = [None] + [panel.name] * (len(groups) - 1), [None] * len(groups)
-    parts, local = [], np.full(len(cut.vertices), -1, dtype=np.int64)
-    owner = np.full(len(cut.vertices), -1, dtype=np.int64)
-    for j, group in enumerate(groups):
-        f = cut.faces[group]
-        used = np.unique(f)
-        local[used] = np.arange(len(used))
-        owner[used] = j
-        parts.append(panel_from_mesh(labels[j], cut.vertices[used], np.searchsorted(used, f),
-                                      name=f"{model.name}: panel {labels[j]}", insert_into=into[j],
-                                      gore_of=of[j]))
-    k = len(groups)
-    renumber = np.array([p if p < index else p + k - 1 for p in range(len(model.panels))])
-    seams = []
-    for seam in model.seams:
-        sides = []
-        for side, p in enumerate(seam.panels):
-            if p != index:
-                sides.append((int(renumber[p]), np.asarray(seam.vertices[side])))
-                continue
-            piece, idx = _on_one_piece(cut.source, owner, np.asarray(seam.vertices[side]))
-            sides.append((index + piece, local[idx]))
-        seams.append(Seam(seam.id, (sides[0][0], sides[1][0]), seam.points, (sides[0][1], sides[1][1]),
-                          seam.length, seam.cad_edge))
-    for left, right in cut.sides:
-        a, b = int(owner[left[0]]), int(owner[right[0]])
-        points = cut.vertices[left]
-        seams.append(Seam(len(seams), (index + a, index + b), points, (local[left], local[right]),
-                          polyline_length(points)))
-    panels = model.panels[:index] + tuple(parts) + model.panels[index + 1:]
-    return Model(model.name, panels, tuple(seams), model.max_edge, model.bookkeeping)
-
-
-def _on_one_piece(source, owner, chain):
-    """The piece a seam chain (original vertex indices) lies on, and its vertices' copies there."""
-    copies = [np.flatnonzero(source == i) for i in chain.tolist()]
-    counts = np.bincount(np.concatenate([owner[c] for c in copies]))
-    piece = int(np.argmax(counts))
-    return piece, np.array([c[owner[c] == piece][0] for c in copies], dtype=np.int64)
-
-
-def _gore_paths(result: Flattening, k: int, limit: float):
+def gore_paths(result: Flattening, k: int, limit: float):
     """``k`` straight cuts from the dart lines' start points to their crown, put into the mesh, or None."""
     lines = dart_lines(result, k, limit, split=True)
     uv = result.uv
@@ -192,11 +142,3 @@ def _gore_paths(result: Flattening, k: int, limit: float):
     if not all((min(a, b), max(a, b)) in edges for path in paths for a, b in zip(path[:-1].tolist(), path[1:].tolist())):
         return None  # a later line split an edge of an earlier one (they met before the crown)
     return v, f, paths
-
-
-def flat_piece(model: Model, p: int, options: dict) -> Flattening:
-    """Panel ``p`` of ``model`` flattened with its seams held (``options``: keywords of :func:`flatten_mesh`)."""
-    panel = model.panels[p]
-    held = held_lengths(model, p, panel.vertices, {}, mesh_edges=unique_edges(panel.faces))
-    return flatten_mesh(panel.vertices, panel.faces, lengths=held, **options)
-

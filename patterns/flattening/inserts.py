@@ -44,10 +44,10 @@ from ..mesh import face_areas
 from ..model import Model
 from ..pattern import Flattening
 from .curvature import crown_of, gore_bound
-from .darts import worst_strain
-from .gores import flat_piece, split_panel
+from .darts import cut_darts, worst_strain
+from .split import FlatPiece, flat_piece, split_panel
 
-__all__ = ["is_saddle", "slashed"]
+__all__ = ["is_saddle", "relieved", "slash_search", "slashed"]
 
 _TRIES = ((0.8, 2.0), (0.9, 3.0))  # (depth towards the trough, spread of the wedges), tried in turn at each count
 _SLIVER = 1e-6  # a try whose cuts leave a triangle of less than this share of the median area is not taken
@@ -92,12 +92,19 @@ def slashed(model: Model, index: int, result: Flattening, limit: float, max_slas
         (``name-insert-1``, ...), for the fewest slashes that bring every
         piece within the limit, or, if none does, the try that came closest.
     """
+    found = slash_search(model, index, result, limit, max_slashes, options)
+    return model if found is None else found[1]
+
+
+def slash_search(model: Model, index: int, result: Flattening, limit: float, max_slashes: int, options: dict):
+    """``(worst piece's strain, model)``: what :func:`slashed` found, or None where it leaves the model unchanged
+    (the panel within the limit or not saddle-shaped)."""
     before = worst_strain(result)
     if before <= limit:
-        return model
+        return None
     defects = angle_defects(result.vertices, result.faces, loops=result.loops)
     if not _mostly_negative(defects):
-        return model
+        return None
     first = int(np.clip(np.ceil(gore_bound(result, limit, defects=-defects)), 1, max_slashes))
     outline = _Outline(result, np.maximum(-defects, 0.0))
     best = (before, model)
@@ -113,7 +120,7 @@ def slashed(model: Model, index: int, result: Flattening, limit: float, max_slas
                 break
             best = (worst, split)
         break
-    return best[1]
+    return best
 
 
 def _slashed(model, index, outline, k, limit, options) -> tuple:
@@ -176,3 +183,50 @@ class _Outline:
         if areas.min() < _SLIVER * float(np.median(areas)):
             return None  # two cuts ran through one point short of the tip
         return v, f, paths
+
+
+def relieved(model: Model, first: int, count: int, limit: float, flat: FlatPiece, *, max_slashes: int,
+             max_darts: int | None = None) -> tuple:
+    """Pieces just split from one panel, each brought towards ``limit``: slashed where saddle-shaped, else darted.
+
+    Parameters
+    ----------
+    model : Model
+        The model the pieces are in.
+    first, count : int
+        The pieces: panels ``first`` to ``first + count - 1``.
+    limit : float
+        The largest principal strain allowed.
+    flat : callable
+        ``flat(model, p) -> (Flattening, held, options)``: panel ``p`` flattened
+        as :func:`patterns.flatten` flattens it, its held seam lengths and the
+        keywords of :func:`flatten_mesh`.
+    max_slashes : int
+        A piece above the limit that is saddle-shaped (:func:`is_saddle`) is
+        slashed and given inserts (:func:`slash_search`), at most this many.
+    max_darts : int, optional
+        Any other piece gets darts, at most this many
+        (:func:`patterns.flattening.darts.cut_darts`); none if not given.
+
+    Returns
+    -------
+    (float, Model, dict)
+        The worst strain of all the pieces (inserts included), the model with
+        the inserts, and ``{piece name: (Flattening, darts, DartSearch)}`` of
+        the pieces darted (where ``max_darts`` is given).
+    """
+    darted, worst = {}, 0.0
+    for p in reversed(range(first, first + count)):  # an insert moves the pieces after its panel, not those before
+        piece, held, options = flat(model, p)
+        panel = model.panels[p]
+        if worst_strain(piece) > limit and max_slashes > 0 and is_saddle(panel.vertices, panel.faces, panel.loops):
+            found = slash_search(model, p, piece, limit, max_slashes, options)
+            if found is not None:
+                worst, model = max(worst, found[0]), found[1]
+                continue
+        if max_darts is not None:
+            darted[panel.name] = cut_darts(piece, limit, max_darts, held, options)
+            piece = darted[panel.name][0]
+        worst = max(worst, worst_strain(piece))
+    return worst, model, darted
+

@@ -15,14 +15,16 @@ from ..errors import InputError
 from ..mesh import polyline_length, unique_edges
 from ..model import Model
 from ..pattern import FlatPanel, FlatSeam, Flattening, Pattern
-from .darts import cut_darts
+from .darts import cut_darts, worst_strain
 from .develop import developed, neutral_offset, offset_along_normals
 from .engine import flatten_mesh
-from .gores import gored
+from .gores import gore_search, gored
 from .grain import grain_table, turn_to_grain
 from .inserts import is_saddle, slashed
+from .parted import darts_needed, parted
 from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
 from .settings import FlattenOptions
+from .split import FlatPiece
 
 __all__ = ["flatten"]
 
@@ -69,6 +71,10 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
           split into the fewest gores (at most ``max_gores``) that each flatten
           within it, every cut a seam (:mod:`patterns.flattening.gores`; each
           piece's :attr:`Panel.gore_of` names the panel it was cut from);
+          without ``gores``, a panel that ``max_darts`` darts cannot bring
+          within the limit is parted into a few pieces with darts
+          (:mod:`patterns.flattening.parted`), or else into gores, at most
+          ``max_gores`` (0: darts on the one panel only);
         * ``max_iterations`` (500), ``energy_tolerance`` (1e-6; ``flatten_mesh``:
           1e-5, a pattern is relaxed to convergence), ``min_stretch``,
           ``energy`` (``"auto"``): the relaxation, see :func:`flatten_mesh`.
@@ -96,27 +102,24 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     offset = neutral_offset(opts.thickness, opts.k_factor, opts.reference, name=model.name)
     grain_table(opts.grain, model)  # bad grain or ease refused before any long work
     eased = validate_ease(opts.ease, model)
+    mode = SeamLengths(opts.seams)
+    darted = {}  # panel name -> (Flattening, darts, DartSearch): darted while the panels were split
     if max_strain is not None:
         keep = {model.seams[s].panels[side] for s, side in eased}  # an eased seam's panel keeps its name
-        model = _split(model, opts, offset, keep)
+        model, darted = _split(model, opts, offset, keep)
         eased = validate_ease(opts.ease, model)
     grains = grain_table(opts.grain, model)
-    mode = SeamLengths(opts.seams)
     eased_panels = {model.seams[s].panels[side] for s, side in eased}
     flat, targets = [], {}
     no_darts = {name for p in model.panels if p.insert_into is not None for name in (p.name, p.insert_into)}
     for i, panel in enumerate(model.panels):
-        name = f"{model.name}: panel {panel.name}"
         darts, search = (), None
         if opts.exact and panel.surface is not None and i not in eased_panels:
-            result = developed(panel, offset, name)
+            result = developed(panel, offset, f"{model.name}: panel {panel.name}")
+        elif panel.name in darted:
+            result, darts, search = darted[panel.name]
         else:
-            vertices = offset_along_normals(panel, offset) if offset else panel.vertices
-            held = None
-            if method == "relaxed":
-                held = held_lengths(model, i, vertices, eased, mode, mesh_edges=unique_edges(panel.faces))
-            options = _engine_options(opts, name)
-            result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
+            result, held, options = _flat_panel(model, i, opts, offset, eased)
             if max_strain is not None and not opts.gores and panel.name not in no_darts:  # slashed, or an insert
                 result, darts, search = cut_darts(result, max_strain, max_darts, held, options)
         targets.update(_side_targets(model, i, result, eased, mode))
@@ -142,29 +145,78 @@ def _engine_options(opts: FlattenOptions, name: str) -> dict:
             "min_stretch": opts.min_stretch, "energy": opts.energy, "name": name}
 
 
-def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> Model:
+def _flat_panel(model: Model, i: int, opts: FlattenOptions, offset: float, eased) -> tuple:
+    """``(Flattening, held, options)``: panel ``i`` by the mesh engine (its neutral surface where ``offset``), its
+    seams held as ``opts.seams`` says (with the ``eased`` sides' ease), and the keywords of :func:`flatten_mesh`."""
+    panel = model.panels[i]
+    vertices = offset_along_normals(panel, offset) if offset else panel.vertices
+    held = None
+    if opts.method == "relaxed":
+        held = held_lengths(model, i, vertices, eased, SeamLengths(opts.seams), mesh_edges=unique_edges(panel.faces))
+    options = _engine_options(opts, f"{model.name}: panel {panel.name}")
+    return flatten_mesh(vertices, panel.faces, lengths=held, **options), held, options
+
+
+def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> tuple:
     """``max_strain``: every freeform panel above the limit split into gores (``gores=True``, :mod:`.gores`),
-    or, if saddle-shaped, slashed and given inserts (:mod:`.inserts`; other panels get darts later).
+    or, if saddle-shaped, slashed and given inserts (:mod:`.inserts`), or else darted, and parted into pieces
+    with darts where darts alone fall short (:func:`_darted`; not with ``max_gores`` 0: darted later).
 
     Panels are taken last to first, so that a split does not move the
-    panels still to be looked at.
+    panels still to be looked at.  Returns the model and ``{panel name:
+    (Flattening, darts, DartSearch)}`` of the panels darted here.
     """
+    darted = {}
     for i in reversed(range(len(model.panels))):
         panel = model.panels[i]
         if (opts.exact and panel.surface is not None) or opts.method != "relaxed" or i in keep:
             continue
-        if not opts.gores and not is_saddle(panel.vertices, panel.faces, panel.loops):
+        saddle = is_saddle(panel.vertices, panel.faces, panel.loops)
+        if not (opts.gores or saddle or opts.max_gores):
             continue
-        name = f"{model.name}: panel {panel.name}"
-        vertices = offset_along_normals(panel, offset) if offset else panel.vertices
-        held = held_lengths(model, i, vertices, {}, SeamLengths(opts.seams), mesh_edges=unique_edges(panel.faces))
-        options = _engine_options(opts, name)
-        result = flatten_mesh(vertices, panel.faces, lengths=held, **options)
+        result, held, options = _flat_panel(model, i, opts, offset, {})
+
+        def flat(m, p):
+            return _flat_panel(m, p, opts, offset, {})
+
         if opts.gores:
-            model = gored(model, i, result, opts.max_strain, opts.max_gores, options)
-        else:
+            model = gored(model, i, result, opts.max_strain, opts.max_gores, flat, max_slashes=opts.max_darts)
+        elif saddle:
             model = slashed(model, i, result, opts.max_strain, opts.max_darts, options)
-    return model
+        else:
+            model, got = _darted(model, i, (result, held, options), opts, flat)
+            darted.update(got)
+    return model, darted
+
+
+def _darted(model: Model, i: int, start: tuple, opts: FlattenOptions, flat: FlatPiece) -> tuple:
+    """``(model, {panel name: (Flattening, darts, DartSearch)})``: panel ``i`` (``start`` = its dartless
+    ``(Flattening, held, options)``; ``flat`` flattens a piece) darted whole, or, where darts alone fall short of the limit, parted into
+    pieces with darts (:func:`.parted.parted`), or else cut into dartless gores (:func:`.gores.gore_search`):
+    the first that meets the limit, or the one that came closest."""
+    result, held, options = start
+    limit, max_darts, name = opts.max_strain, opts.max_darts, model.panels[i].name
+    whole = None
+    if worst_strain(result) <= limit or darts_needed(result, limit) <= max_darts:
+        whole = cut_darts(result, limit, max_darts, held, options)
+        if worst_strain(whole[0]) <= limit:
+            return model, {name: whole}
+    tries = []  # (worst strain, model, darted panels), in the order preferred on a tie
+    pieces = parted(model, i, result, limit, max_darts, opts.max_gores, flat)
+    if pieces is not None:
+        tries.append(pieces)
+        if pieces[0] <= limit:
+            return pieces[1], pieces[2]
+    gores = gore_search(model, i, result, limit, opts.max_gores, flat, max_slashes=max_darts)
+    if gores is not None:
+        tries.append((gores[0], gores[1], {}))
+        if gores[0] <= limit:
+            return gores[1], {}
+    if whole is None:
+        whole = cut_darts(result, limit, max_darts, held, options)
+    tries.insert(0, (worst_strain(whole[0]), model, {name: whole}))
+    _, closest, got = min(tries, key=lambda t: t[0])
+    return closest, got
 
 
 def _flat_length(flat: FlatPanel, edges: np.ndarray, idx, seam) -> float:

@@ -111,8 +111,10 @@ class FlattenOptions(Options):
     gores: bool = option(False, "with a strain limit: split a panel above it into gores along the dart lines, "
                                 "run on to the crown, each cut a seam held at its 3D length, instead of darts "
                                 "that stop short")
-    max_gores: int = option(24, "with gores: at most this many gores per panel (cuts from its outline), 1..100",
-                            low=1, high=100, integer=True, metavar="N")
+    max_gores: int = option(24, "at most this many pieces (cuts from its outline) a panel above the strain limit "
+                                "is split into: gores, or, with darts, pieces with darts where max_darts darts "
+                                "alone fall short (0: darts only, never split), 0..100",
+                            low=0, high=100, integer=True, metavar="N")
     max_iterations: int = option(500, "relaxed: at most this many relaxation iterations (up to 100000)", low=0,
                                  low_open=True, high=100_000, integer=True, metavar="N")
     energy_tolerance: float = option(1e-6, "relaxed: stop when the energy falls by less than this fraction per "
@@ -131,5 +133,7 @@ class FlattenOptions(Options):
                     raise InputError(f"{label(name)} applies to {label('method')} relaxed only")
             if self.energy != "auto":
                 raise InputError(f"{label('energy')} applies to {label('method')} relaxed only")
+        if self.gores and self.max_gores < 1:
+            raise InputError(f"{label('gores')} needs {label('max_gores')} 1 or more")
         if self.ease and self.seams == "free":
             raise InputError(f"{label('ease')} needs {label('seams')} true or total")

@@ -1,0 +1,100 @@
+"""Pieces with darts: a panel that darts alone cannot bring within the strain limit, parted into a few pieces.
+
+A pattern maker whose dome asks for more darts than one panel can take adds
+style seams: a bowl's cover in three pieces with four or five darts each, not
+one panel with fourteen.  :func:`parted` is what :func:`patterns.flatten` does
+with ``max_strain`` (darts: not ``gores=True``) on a panel that is not
+saddle-shaped, before its darts:
+
+* **When.**  Where the panel's gore bound asks for more darts than
+  ``max_darts`` allows (darts need about 1.2 times the bound,
+  :func:`patterns.flattening.curvature.gore_bound`: then no dart is tried on
+  the whole panel), or where the darts tried on it fell short of the limit.
+* **How.**  Cut as gores are (:func:`patterns.flattening.split.split_panel`,
+  straight cuts from evenly spaced outline points to one crown), each cut a
+  seam held at its 3D length; each piece flattened with its seams held and
+  darted (:func:`patterns.flattening.darts.cut_darts`, at most ``max_darts``
+  each: the pieces are sewn to each other, so their darts run towards the
+  corner where the seams meet).
+* **How many pieces.**  The fewest whose gore bound is at most
+  :data:`_PIECE_BOUND` each, and never fewer than three, then one more
+  (:data:`_COUNTS` counts at most): measured on the benchmark's domes, halves
+  of a dome do not take darts well (the oblate dome: one half 15 % after 17
+  tries; the ellipsoid: both halves 10 %), thirds and quarters do (the bowl,
+  the oblate dome and the ellipsoid all meet 3 % in three pieces).
+* **Saddles slashed.**  A piece above the limit that is saddle-shaped (a
+  seat's waist beside its dome) is slashed and given inserts
+  (:func:`patterns.flattening.inserts.relieved`, at most ``max_darts``
+  slashes), not darted: a dart takes out material a saddle lacks.
+* **Or gores.**  Where no count tried meets the limit, the caller cuts
+  dartless gores (:func:`patterns.flattening.gores.gored`, at most
+  ``max_gores``) and keeps whichever came closest.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model import Model
+from ..pattern import Flattening
+from .curvature import gore_bound
+from .gores import gore_paths
+from .inserts import relieved
+from .split import FlatPiece, split_panel
+
+__all__ = ["darts_needed", "parted"]
+
+_PIECE_BOUND = 4.0  # a piece's share of the gore bound at most this (about 5 darts a piece)
+_COUNTS = 2  # piece counts tried: the first and one more
+_DARTS_PER_BOUND = 1.2  # darts a panel needs per unit of gore bound (measured: the hemisphere, 11 against 9.07)
+
+
+def darts_needed(result: Flattening, limit: float) -> float:
+    """About how many darts the panel needs to come within ``limit``: 1.2 times its gore bound."""
+    return _DARTS_PER_BOUND * gore_bound(result, limit)
+
+
+def parted(model: Model, index: int, result: Flattening, limit: float, max_darts: int, max_pieces: int,
+           flat: FlatPiece):
+    """Panel ``index`` parted into the fewest pieces tried that each come within ``limit`` with darts.
+
+    Parameters
+    ----------
+    model : Model
+    index : int
+        The panel to part.
+    result : Flattening
+        Its dartless flattening (the cuts are drawn on it).
+    limit : float
+        The largest principal strain allowed.
+    max_darts : int
+        At most this many darts per piece.
+    max_pieces : int
+        At most this many cuts (``max_gores``).
+    flat : callable
+        ``flat(model, p) -> (Flattening, held, options)``: panel ``p`` of a
+        model flattened as :func:`patterns.flatten` flattens it, its held seam
+        lengths and the keywords of :func:`flatten_mesh`.
+
+    Returns
+    -------
+    (float, Model, dict) or None
+        The worst piece's strain, the parted model and ``{piece name: (Flattening,
+        darts, DartSearch)}``: the first count tried that meets the limit, or
+        the one that came closest; None where no count could be cut.
+    """
+    first = max(3, int(np.ceil(gore_bound(result, limit) / _PIECE_BOUND)))
+    best = None
+    for k in range(first, min(first + _COUNTS, max_pieces + 1)):
+        paths = gore_paths(result, k, limit)
+        split = None if paths is None else split_panel(model, index, paths)
+        if split is None:
+            continue
+        worst, split, darted = relieved(split, index, len(split.panels) - len(model.panels) + 1, limit, flat,
+                                        max_slashes=max_darts, max_darts=max_darts)
+        if best is None or worst < best[0]:
+            best = (worst, split, darted)
+        if worst <= limit:
+            break
+    return best
+
