@@ -444,14 +444,12 @@ def _gore_notes(pattern, max_strain) -> list:
         point = first.uv[first.faces[i]].mean(axis=0)
         names = [g.name for g in gores]
         listed = ", ".join(names) if len(names) <= 4 else f"{names[0]} ... {names[-1]}"
-        darts = [len(g.darts) for g in gores]
-        if any(darts):  # parted in darts mode: darts alone could not bring the panel within the limit
-            text = (f"panel {name}: split into {counted(len(gores), 'piece')} ({listed}) along cuts from its outline "
-                    f"to its crown, each cut a seam held at its 3D length, with {', '.join(map(str, darts))} darts: "
-                    f"darts alone (at most max_darts on one panel) could not bring it within the strain limit")
-        else:
-            text = (f"panel {name}: split into {counted(len(gores), 'gore')} ({listed}) along cuts from its outline "
-                    f"to its crown, each cut a seam held at its 3D length")
+        darts = [len(g.darts) for g in gores]  # any: parted in darts mode, darts alone fell short
+        text = (f"panel {name}: split into {counted(len(gores), 'piece' if any(darts) else 'gore')} ({listed}) "
+                f"along cuts from its outline to its crown, each cut a seam held at its 3D length")
+        if any(darts):
+            text += (f", with {', '.join(map(str, darts))} darts: darts alone (at most max_darts on one panel) "
+                     f"could not bring it within the strain limit")
         if max_strain is not None and worst[at] > max_strain:
             text += (f"; the strain limit {max_strain:.2%} was not met: the worst gore reaches {worst[at]:.2%} at "
                      f"({point[0]:.1f}, {point[1]:.1f}) mm (panel {first.name}): allow more gores (max_gores)")

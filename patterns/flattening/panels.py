@@ -166,6 +166,9 @@ def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> tupl
     panels still to be looked at.  Returns the model and ``{panel name:
     (Flattening, darts, DartSearch)}`` of the panels darted here.
     """
+    def flat(m: Model, p: int) -> tuple:  # a piece of a split panel, flattened as the panels are
+        return _flat_panel(m, p, opts, offset, {})
+
     darted = {}
     for i in reversed(range(len(model.panels))):
         panel = model.panels[i]
@@ -175,10 +178,6 @@ def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> tupl
         if not (opts.gores or saddle or opts.max_gores):
             continue
         result, held, options = _flat_panel(model, i, opts, offset, {})
-
-        def flat(m, p):
-            return _flat_panel(m, p, opts, offset, {})
-
         if opts.gores:
             model = gored(model, i, result, opts.max_strain, opts.max_gores, flat, max_slashes=opts.max_darts)
         elif saddle:

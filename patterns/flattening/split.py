@@ -65,9 +65,10 @@ def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Mo
                                       gore_of=of[j]))
     k = len(groups)
     renumber = np.array([p if p < index else p + k - 1 for p in range(len(model.panels))])
+    copies_of = _copies(cut.source)
     seams, later = [], []
     for seam in model.seams:
-        runs = _runs(seam, index, cut.source, owner)
+        runs = _runs(seam, index, copies_of, owner)
         for r, (lo, hi, pieces_at) in enumerate(runs):
             sides = tuple(int(renumber[p]) if p != index else index + pieces_at[side][0]
                           for side, p in enumerate(seam.panels))
@@ -88,7 +89,20 @@ def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Mo
     return Model(model.name, panels, tuple(seams), model.max_edge, model.bookkeeping)
 
 
-def _runs(seam, index, source, owner) -> list:
+def _copies(source: np.ndarray):
+    """``copies(chain) -> [cut vertices of each original vertex of chain]`` (ascending), from one sort of ``source``."""
+    order = np.argsort(source, kind="stable")
+    ranked = source[order]
+
+    def copies(chain) -> list:
+        chain = np.asarray(chain)
+        lows, highs = np.searchsorted(ranked, chain, "left"), np.searchsorted(ranked, chain, "right")
+        return [order[a:b] for a, b in zip(lows.tolist(), highs.tolist())]
+
+    return copies
+
+
+def _runs(seam, index, copies_of, owner) -> list:
     """A seam cut into the runs that lie on one piece each: ``[(first, last, pieces_at), ...]``.
 
     ``first`` and ``last`` index the seam's points (a run shares its last point
@@ -99,7 +113,7 @@ def _runs(seam, index, source, owner) -> list:
     """
     on = [side for side, p in enumerate(seam.panels) if p == index]
     n = len(seam.points)
-    copies = {side: [np.flatnonzero(source == i) for i in np.asarray(seam.vertices[side]).tolist()] for side in on}
+    copies = {side: copies_of(seam.vertices[side]) for side in on}
     held = {side: [set(owner[c].tolist()) for c in copies[side]] for side in on}
     runs, first = [], 0
     while first < n - 1:
