@@ -51,7 +51,7 @@ from .sheetmetal import BendTable, UnfoldOptions, read_bend_table, unfold
 from .tessellate import MeshingOptions, mesh_shape, tessellate_face
 from .units import Unit
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = [
     "ENERGIES",

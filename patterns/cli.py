@@ -8,6 +8,8 @@ Subcommands::
     patterns check INPUT [--max-strain R] [--max-seam-mismatch MM] [--report OUT.json]
     patterns info INPUT
     patterns demo [-o DIR]
+    patterns serve                     (the engine for a CAD program: JSON lines, docs/worker.md)
+    patterns freecad install|uninstall [--user-dir DIR]
     patterns batch DIR -o OUTDIR [--jobs N] [--scheduler ADDRESS] [--timeout S] [--report] [--preview]
                    [--unfold [--k-factor K | --bend-table CSV]]
     patterns unfold PART.STEP -o BLANK.dxf [--k-factor K | --bend-table CSV | --material NAME] [--fixed-face N]
@@ -142,6 +144,14 @@ def _parser() -> argparse.ArgumentParser:
     add_arguments(batch.add_argument_group("unfolding (with --unfold)"), UnfoldOptions)
     checking(batch, report=False)
     output(batch)
+    sub.add_parser("serve", help="run the engine for a CAD program (FreeCAD's workbench): JSON lines on standard "
+                                 "input and output (docs/worker.md)")
+    host = sub.add_parser("freecad", help="put the Patterns workbench into FreeCAD (install), or take it out "
+                                          "(uninstall); the engine stays in this environment")
+    host.add_argument("action", choices=("install", "uninstall"), help="install or uninstall")
+    host.add_argument("--user-dir", type=Path, default=None, metavar="DIR",
+                      help="FreeCAD's user data folder (Mod inside; default: $FREECAD_USER_DATA, $FREECAD_USER_HOME, "
+                           "or the platform's)")
     parser.commands = sub.choices  # {command: its parser}, for the unknown options' "did you mean"
     return parser
 
@@ -488,8 +498,27 @@ def _cmd_unfold(args) -> int:
     return EXIT_OK
 
 
+def _cmd_serve(args) -> int:
+    from .service import serve
+
+    return serve()
+
+
+def _cmd_freecad(args) -> int:
+    from .hosts import freecad
+
+    if args.action == "install":
+        folder = freecad.install(args.user_dir)
+        print(f"installed the Patterns workbench in {folder}; its engine is {sys.executable} (this environment). "
+              f"Start FreeCAD and pick the Patterns workbench; `patterns freecad uninstall` takes it out")
+    else:
+        folder = freecad.uninstall(args.user_dir)
+        print(f"removed {folder}" if folder else f"no Patterns workbench in {freecad.user_dir(args.user_dir) / 'Mod'}")
+    return EXIT_OK
+
+
 COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "demo": _cmd_demo, "unfold": _cmd_unfold,
-            "batch": _cmd_batch}
+            "batch": _cmd_batch, "serve": _cmd_serve, "freecad": _cmd_freecad}
 
 
 # --------------------------------------------------------------------------- #

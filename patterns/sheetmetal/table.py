@@ -140,6 +140,19 @@ K_DEFAULT = 0.5
 """The K-factor when none is given (the neutral layer in the middle of the sheet)."""
 
 
+def parse_face(text: str) -> int:
+    """A face's index from the command line or a CAD program: ``21`` (0-based, as ``shape.faces()``) or
+    FreeCAD's 1-based name ``Face21`` (index 20)."""
+    text = text.strip()
+    if text[:4].lower() == "face" and text[4:].isdigit() and int(text[4:]) >= 1:
+        return int(text[4:]) - 1
+    try:
+        return int(text)
+    except ValueError:
+        raise ValueError(f"expected a face index (0, 1, ...) or FreeCAD's face name (Face1, Face2, ...), "
+                         f"got {text!r}") from None
+
+
 def _table(value, option):
     if isinstance(value, BendTable):
         return value
@@ -157,9 +170,10 @@ class UnfoldOptions(Options):
     bend_table: BendTable | None = option(None, "bend-deduction table, CSV with columns thickness, radius, angle, "
                                       "deduction (mm, degrees); it gives every bend instead of the K-factor",
                                 optional=True, check=_table, metavar="CSV")
-    fixed_face: int | None = option(None, "the CAD face that keeps its place (shape.faces() index; default the "
-                                          "largest planar face that starts a sheet)", integer=True, low=0, optional=True,
-                                    metavar="N")
+    fixed_face: int | None = option(None, "the CAD face that keeps its place (shape.faces() index, or FreeCAD's "
+                                          "name FaceN for index N-1; default the largest planar face that starts a "
+                                          "sheet)", integer=True, low=0, optional=True, metavar="N",
+                                    parse=parse_face)
     corner_relief: str = option("none", "where two bends meet at a corner: none (the flanges' edges run on until "
                                         "they meet, as SolidWorks draws a closed corner), rectangular (the square "
                                         "where the bend zones cross cut out), round (a circle about the bend lines' "

@@ -1,16 +1,12 @@
-"""Run with ``PATTERNS_SITE=... BLOCKS=<json file> OUT=<json file> freecadcmd freecad_docs_run.py`` in a folder
-where ``samples/`` is the repository's: runs the Python blocks of docs/freecad.md in order, in one
-namespace, inside FreeCAD, and writes ``{line: "ok" or the traceback}`` to ``OUT``."""
+"""Run with ``FREECAD_USER_HOME=<dir> BLOCKS=<json file> OUT=<json file> freecadcmd freecad_docs_run.py`` in a
+folder where ``samples/`` is the repository's, the workbench installed in ``<dir>`` by ``patterns freecad
+install``: runs the Python blocks of docs/freecad.md in order, in one namespace, inside FreeCAD, and writes
+``{line: "ok" or the traceback}`` to ``OUT``."""
 
 import json
 import os
-import site
 import sys
 import traceback
-
-before = list(sys.path)
-site.addsitedir(os.environ["PATTERNS_SITE"])
-sys.path[:] = [p for p in sys.path if p not in before] + before
 
 namespace = {"__name__": "__docs__"}
 results = {}
@@ -24,3 +20,5 @@ for line, code in blocks:
         results[str(line)] = traceback.format_exc()
 with open(os.environ["OUT"], "w", encoding="utf-8") as f:
     json.dump(results, f)
+sys.stdout.flush()
+os._exit(0)

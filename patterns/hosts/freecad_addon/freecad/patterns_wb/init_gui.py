@@ -4,7 +4,7 @@ import os
 
 import FreeCADGui as Gui
 
-from . import ICONS
+from .engine import ICONS
 
 
 class PatternsWorkbench(Gui.Workbench):
@@ -20,6 +20,13 @@ class PatternsWorkbench(Gui.Workbench):
         commands.register()
         self.appendToolbar("Patterns", list(commands.COMMANDS))
         self.appendMenu("Patterns", list(commands.COMMANDS))
+
+    def Activated(self):
+        """Start the engine now, so the first Flatten does not wait; where it cannot start, one dialog says
+        the commands to run (the commands stay, and work once that is done, without a restart)."""
+        from . import commands
+
+        commands.warm()
 
     def GetClassName(self):
         return "Gui::PythonWorkbench"

@@ -1,0 +1,96 @@
+"""``patterns freecad install`` and ``uninstall``: the workbench into FreeCAD's ``Mod`` folder, and back out.
+
+The workbench (``freecad_addon/``: ``package.xml`` and the ``freecad.patterns_wb`` package, FreeCAD and
+the standard library only) is copied to ``<FreeCAD's user data folder>/Mod/patterns``, with an
+``engine.json`` that records which engine to start: this interpreter running ``-m patterns``.  Nothing is
+installed into FreeCAD's Python; FreeCAD keeps its own numpy, and every other workbench its packages.
+
+FreeCAD's user data folder: ``--user-dir``; else ``$FREECAD_USER_DATA`` or ``$FREECAD_USER_HOME`` (as
+FreeCAD takes them); else the platform's: ``$XDG_DATA_HOME/FreeCAD`` or ``~/.local/share/FreeCAD`` on
+Linux (FreeCAD 0.20, 0.21 and 1.0; ``~/.FreeCAD`` where only that exists, as older ones used),
+``~/Library/Application Support/FreeCAD`` on macOS, ``%APPDATA%\\FreeCAD`` on Windows.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+from ..errors import InputError
+
+__all__ = ["ADDON", "NAME", "install", "uninstall", "user_dir"]
+
+ADDON = Path(__file__).resolve().parent / "freecad_addon"
+"""The workbench's files, as they go into ``Mod/patterns``."""
+NAME = "patterns"
+"""The folder's name in ``Mod``."""
+MARK = "engine.json"
+"""The file that says a ``Mod/patterns`` folder is ours (an uninstall removes no other)."""
+
+
+def user_dir(given: Path | None = None, *, environ=None, platform: str | None = None, home: Path | None = None) -> Path:
+    """FreeCAD's user data folder: ``given``, else as the module says."""
+    if given is not None:
+        return Path(given).expanduser()
+    environ = os.environ if environ is None else environ
+    for name in ("FREECAD_USER_DATA", "FREECAD_USER_HOME"):
+        if environ.get(name):
+            return Path(environ[name]).expanduser()
+    platform = platform or sys.platform
+    home = home or Path.home()
+    if platform.startswith("win"):
+        return Path(environ.get("APPDATA") or home / "AppData" / "Roaming") / "FreeCAD"
+    if platform == "darwin":
+        return home / "Library" / "Application Support" / "FreeCAD"
+    xdg = Path(environ.get("XDG_DATA_HOME") or home / ".local" / "share") / "FreeCAD"
+    legacy = home / ".FreeCAD"
+    return legacy if legacy.is_dir() and not xdg.is_dir() else xdg
+
+
+def _engine_command() -> list:
+    return [sys.executable, "-m", "patterns"]
+
+
+def install(user: Path | None = None) -> Path:
+    """Put the workbench into ``<user>/Mod/patterns`` (replacing an earlier one of ours) and record this
+    interpreter as its engine; returns the folder.  InputError if the place is taken by something else or
+    cannot be written."""
+    from .. import __version__
+    from ..service import PROTOCOL
+
+    mod = user_dir(user) / "Mod"
+    target = mod / NAME
+    if target.exists() and not (target / MARK).is_file():
+        raise InputError(f"{target}: a folder that is not a patterns workbench is in the way (move it aside)")
+    try:
+        mod.mkdir(parents=True, exist_ok=True)
+        staging = Path(tempfile.mkdtemp(prefix=".patterns-", dir=mod))
+    except OSError as exc:
+        raise InputError(f"{mod}: cannot write there ({exc.strerror})") from None
+    try:
+        folder = staging / NAME
+        shutil.copytree(ADDON, folder, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        record = {"command": _engine_command(), "version": __version__, "protocol": PROTOCOL}
+        (folder / MARK).write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
+        if target.exists():
+            shutil.rmtree(target)
+        folder.rename(target)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return target
+
+
+def uninstall(user: Path | None = None) -> Path | None:
+    """Take the workbench out of ``<user>/Mod``; returns the folder removed, or None if there was none.
+    InputError if the folder there is not ours."""
+    target = user_dir(user) / "Mod" / NAME
+    if not target.exists():
+        return None
+    if not (target / MARK).is_file():
+        raise InputError(f"{target}: not a patterns workbench (no {MARK}); left as it is")
+    shutil.rmtree(target)
+    return target

@@ -1,0 +1,79 @@
+"""The engine's options as properties of a FreeCAD object, from the schema the engine sends.
+
+Each option is one property in its record's group: a switch (``App::PropertyBool``), a choice
+(``App::PropertyEnumeration``), a number (``App::PropertyInteger``, ``App::PropertyFloat``), or text for
+the rest (empty is the default).  Nothing is declared or checked here: the engine's option records are the
+one declaration and the one validator; the values go to the engine as they are
+(:func:`check_options` asks it).
+"""
+
+from .engine import EngineError, Refused, engine
+
+
+class PatternsError(ValueError):
+    """A request the engine refused (a bad option, a shape it cannot use), or an engine that cannot answer;
+    the message says which and what to do."""
+
+
+def check_options(kind, options, label):
+    """Check options with the engine's records before anything is added (PatternsError saying what is wrong)."""
+    try:
+        names = {p["name"] for p in engine().options[kind]}
+        unknown = sorted(set(options) - names)
+        if unknown:
+            raise PatternsError(f"{label}: unknown option {unknown[0]!r}; the options are {', '.join(sorted(names))}")
+        engine().request("validate", kind=kind, options=options, name=label)
+    except (EngineError, Refused) as exc:
+        raise PatternsError(str(exc)) from None
+
+
+KINDS = {"bool": "App::PropertyBool", "choice": "App::PropertyEnumeration", "int": "App::PropertyInteger",
+         "float": "App::PropertyFloat", "text": "App::PropertyString"}
+"""FreeCAD's property type of each kind of option."""
+
+
+def add(obj, properties):
+    """Add a property for every option (``properties``: the engine's schema of the object's kind)."""
+    for p in properties:
+        if p["name"] in obj.PropertiesList:
+            continue
+        text = p["help"][:1].upper() + p["help"][1:] + "."
+        obj.addProperty(KINDS[p["kind"]], p["name"], p["group"], text)
+        if p["kind"] == "choice":
+            setattr(obj, p["name"], list(p["choices"]))
+        setattr(obj, p["name"], p["default"])
+
+
+def value(obj, p):
+    """One option's value on ``obj``, in the kind the schema gives."""
+    got = getattr(obj, p["name"])
+    if p["kind"] == "float":
+        return float(got)
+    if p["kind"] == "int":
+        return int(got)
+    if p["kind"] == "bool":
+        return bool(got)
+    return str(got)
+
+
+def changed(obj, properties):
+    """``{name: value}`` of the options set away from their defaults (what the engine is sent)."""
+    out = {}
+    for p in properties:
+        if p["name"] in obj.PropertiesList:
+            got = value(obj, p)
+            if got != p["default"]:
+                out[p["name"]] = got
+    return out
+
+
+def set_values(obj, properties, values, label):
+    """Set options given by property name; ValueError naming an unknown one."""
+    known = {p["name"]: p for p in properties}
+    for name, given in values.items():
+        if name not in known:
+            raise ValueError(f"{label}: unknown option {name!r}; the options are {', '.join(sorted(known))}")
+        kind = known[name]["kind"]
+        if kind in ("text", "choice"):
+            given = "" if given is None else str(given)
+        setattr(obj, name, given)

@@ -1,0 +1,177 @@
+"""What the worker does for a host: make a pattern or a blank of a shape, export it, say what it found.
+
+Each object is computed as ``patterns flatten`` (or ``unfold``) computes it -- load through the library's
+one reading path, flatten or unfold, pieces, nest when asked, check -- and answered as BREP text and plain
+numbers (:func:`make`).  The last results are kept by the request's key (:class:`Results`), so an export
+right after a recompute writes the pieces the host shows without computing them again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from collections import OrderedDict
+from dataclasses import dataclass
+
+from ..audit import CheckOptions, Report, checked_drawing
+from ..errors import InputError
+from ..export import WriteOptions, write
+from ..export.layers import PRESETS
+from ..flattening import FlattenOptions, flatten
+from ..nesting import NestOptions, layout
+from ..pattern import Pattern
+from ..pieces import Drawing, PieceOptions, drawing_of, piece_labels
+from ..sheetmetal import UnfoldOptions, unfold
+from ..tessellate import MeshingOptions, mesh_shape
+from . import brep
+from .schema import records_of
+
+__all__ = ["Made", "Results", "export", "figures", "key_of", "make", "validate"]
+
+
+def key_of(kind: str, shape: str, options: dict) -> str:
+    """The key of a request's result: SHA-256 of its kind, shape and options (what a host hashes too)."""
+    text = json.dumps([kind, options], sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode() + b"\0" + shape.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class Made:
+    """One computed object: the subject (a Pattern or a Blank), its drawing, the checked drawing, the report."""
+
+    subject: Pattern | object
+    drawing: Drawing
+    checked: Drawing
+    report: Report
+
+
+class Results:
+    """The last ``size`` results, by key (oldest dropped first); ``computed`` counts the computations."""
+
+    def __init__(self, size: int = 8):
+        self.size, self.computed = size, 0
+        self._items: OrderedDict = OrderedDict()
+
+    def get(self, kind: str, shape: str, options: dict, name: str) -> Made:
+        key = key_of(kind, shape, options)
+        if key in self._items:
+            self._items.move_to_end(key)
+            return self._items[key]
+        made = _compute(kind, shape, options, name)
+        self.computed += 1
+        self._items[key] = made
+        while len(self._items) > self.size:
+            self._items.popitem(last=False)
+        return made
+
+
+def _compute(kind: str, shape: str, options: dict, name: str) -> Made:
+    records = records_of(kind, options, name=name)  # every option checked before the shape is read
+    source = brep.from_brep(shape, name)
+    if kind == "pattern":
+        subject = flatten(mesh_shape(source, records[MeshingOptions], name=name), records[FlattenOptions])
+    else:
+        subject = unfold(source, records[UnfoldOptions], name=name)
+    nesting = records[NestOptions]
+    if nesting.active:
+        drawing = layout(subject, nesting, pieces=records[PieceOptions]).drawing()
+    else:
+        drawing = drawing_of(subject, records[PieceOptions])
+    report, checked = checked_drawing(subject, drawing, records[CheckOptions])
+    return Made(subject, drawing, checked, report)
+
+
+def _face_strain(made: Made, n_faces: int) -> list:
+    """The largest principal strain of the panel of each of the source's ``n_faces`` faces (0 for a blank)."""
+    strain = [0.0] * n_faces
+    if isinstance(made.subject, Pattern):
+        for flat, numbers in zip(made.subject.panels, made.report.panels):
+            for face in flat.panel.cad_faces:
+                if 0 <= face < n_faces:
+                    strain[face] = float(numbers.strain_max)
+    return strain
+
+
+def figures(report: Report) -> dict:
+    """The check's figures a host shows: the worst strain and where (panel, point in the drawing, mm), the
+    share of the 3D area above the limit, the largest seam mismatch and where, the findings by severity."""
+    worst = max(report.panels, key=lambda p: p.strain_max, default=None)
+    area = sum(p.area_3d for p in report.panels)
+    above = [p for p in report.panels if p.share_above_limit is not None]
+    seam = max(report.seams, key=lambda s: abs(s.mismatch), default=None)
+    counts: dict = {}
+    for f in report.findings:
+        counts[f.severity.value] = counts.get(f.severity.value, 0) + 1
+    return {
+        "ok": report.ok,
+        "max_strain": report.max_strain,
+        "strain_max": None if worst is None else worst.strain_max,
+        "strain_max_panel": None if worst is None else worst.name,
+        "strain_max_at": None if worst is None else [float(c) for c in worst.strain_max_at],
+        "share_above_limit": (sum(p.share_above_limit * p.area_3d for p in above) / area) if above and area else None,
+        "seam_mismatch": None if seam is None else abs(seam.mismatch),
+        "seam_mismatch_at": None if seam is None else f"seam {seam.id} ({' | '.join(seam.panels)})",
+        "panels": len(report.panels), "seams": len(report.seams), "blanks": len(report.blanks),
+        "findings": counts,
+    }
+
+
+def make(results: Results, request: dict) -> dict:
+    """The reply to ``make``: the pieces (BREP), their marks, labels, the report and its figures."""
+    started = time.perf_counter()
+    kind, shape, options, name = _fields(request)
+    made = results.get(kind, shape, options, name)
+    labels = [label for p in made.drawing.pieces for label in piece_labels(p)]
+    marks = brep.marks(made.drawing.pieces, labels)
+    n_faces = request.get("faces", 0)
+    if not isinstance(n_faces, int) or n_faces < 0:
+        raise InputError(f"{name}: faces must be a count, got {n_faces!r}")
+    return {
+        "key": key_of(kind, shape, options),
+        "shape": brep.pieces_brep(made.drawing.pieces, bends=kind == "blank"),
+        "marks": marks,
+        "colours": {role: layer.color for role, layer in PRESETS["patterns"].items()},
+        "labels": [lb.text for lb in labels],
+        "pieces": len(made.drawing.pieces),
+        "ok": made.report.ok,
+        "report": str(made.report),
+        "figures": figures(made.report),
+        "face_strain": _face_strain(made, n_faces),
+        "seconds": time.perf_counter() - started,
+    }
+
+
+def validate(request: dict) -> dict:
+    """The reply to ``validate``: the options checked by their records, nothing computed (InputError if bad)."""
+    name = request.get("name") or "shape"
+    records_of(request.get("kind"), request.get("options") or {}, name=str(name))
+    return {}
+
+
+def export(results: Results, request: dict) -> dict:
+    """The reply to ``export``: the object's pieces written to ``path`` by :func:`patterns.write` (the
+    suffix chooses: ``.dxf``, ``.svg``, ``.json``), with ``write`` options (:class:`patterns.WriteOptions`)."""
+    kind, shape, options, name = _fields(request)
+    path = request.get("path")
+    if not isinstance(path, str) or not path:
+        raise InputError(f"{name}: export needs a path")
+    extra = request.get("write") or {}
+    if not isinstance(extra, dict):
+        raise InputError(f"{name}: write options must be an object of WriteOptions fields")
+    WriteOptions.of(None, extra, name=name)  # checked before any work
+    made = results.get(kind, shape, options, name)
+    write(made.checked if path.lower().endswith(".json") else made.drawing, path, **extra)
+    return {"path": path}
+
+
+def _fields(request: dict) -> tuple:
+    name = request.get("name") or "shape"
+    if not isinstance(name, str):
+        raise InputError("name must be text")
+    kind, shape, options = request.get("kind"), request.get("shape"), request.get("options") or {}
+    if not isinstance(kind, str):
+        raise InputError(f"{name}: kind must be 'pattern' or 'blank'")
+    if not isinstance(shape, str):
+        raise InputError(f"{name}: shape must be BREP text")
+    return kind, shape, options, name
