@@ -144,6 +144,13 @@ def _parser() -> argparse.ArgumentParser:
     add_arguments(batch.add_argument_group("unfolding (with --unfold)"), UnfoldOptions)
     checking(batch, report=False)
     output(batch)
+    _host_commands(sub)
+    parser.commands = sub.choices  # {command: its parser}, for the unknown options' "did you mean"
+    return parser
+
+
+def _host_commands(sub) -> None:
+    """``serve`` (the engine for a CAD program) and ``freecad install|uninstall``."""
     sub.add_parser("serve", help="run the engine for a CAD program (FreeCAD's workbench): JSON lines on standard "
                                  "input and output (docs/worker.md)")
     host = sub.add_parser("freecad", help="put the Patterns workbench into FreeCAD (install), or take it out "
@@ -152,8 +159,6 @@ def _parser() -> argparse.ArgumentParser:
     host.add_argument("--user-dir", type=Path, default=None, metavar="DIR",
                       help="FreeCAD's user data folder (Mod inside; default: $FREECAD_USER_DATA, $FREECAD_USER_HOME, "
                            "or the platform's)")
-    parser.commands = sub.choices  # {command: its parser}, for the unknown options' "did you mean"
-    return parser
 
 
 def _parse(argv) -> argparse.Namespace:
@@ -498,10 +503,14 @@ def _cmd_unfold(args) -> int:
     return EXIT_OK
 
 
-def _cmd_serve(args) -> int:
+def _serve() -> int:
+    """``patterns serve``: the protocol's standard output kept before any import could print to it."""
+    from .service.server import protocol_output
+
+    out = protocol_output()
     from .service import serve
 
-    return serve()
+    return serve(sys.stdin.buffer, out)
 
 
 def _cmd_freecad(args) -> int:
@@ -518,7 +527,7 @@ def _cmd_freecad(args) -> int:
 
 
 COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "demo": _cmd_demo, "unfold": _cmd_unfold,
-            "batch": _cmd_batch, "serve": _cmd_serve, "freecad": _cmd_freecad}
+            "batch": _cmd_batch, "freecad": _cmd_freecad}
 
 
 # --------------------------------------------------------------------------- #
@@ -544,6 +553,8 @@ def main(argv=None) -> int:
     except ValueError:  # not the main thread (a test harness): no handler
         pass
     try:
+        if argv == ["serve"]:  # the engine for a CAD program (docs/worker.md): its standard output is the protocol's
+            return _serve()
         args = _parse(argv)
         return COMMANDS[args.command](args)
     except PatternsError as exc:

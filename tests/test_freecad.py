@@ -108,6 +108,7 @@ def test_a_bad_option_is_refused_before_anything_is_added(tmp_path):
     assert "seam_allowance (mm) must be a number between 0 and 1000, got -3" in result["seam_allowance"]
     assert "unknown option 'no_such_option'" in result["no_such_option"]
     assert result["objects"] == ["Box", "Cylinder", "Cut"]
+    assert result["text_number"] == 5.0
 
 
 def test_a_failed_create_leaves_nothing_in_the_document(tmp_path):

@@ -34,7 +34,7 @@ class Worker:
 
     def __init__(self):
         self.proc = subprocess.Popen([sys.executable, "-m", "patterns", "serve"], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
 
     def ask(self, message) -> dict:
         line = message if isinstance(message, bytes) else json.dumps(message).encode()
@@ -82,7 +82,7 @@ def test_a_shape_is_flattened_as_the_api_flattens_it(worker, tmp_path):
     assert sorted(f.area for f in pieces.faces()) == pytest.approx(sorted(p.area for p in api.panels), rel=1e-9)
     assert all(abs(v.Z) == 0 for v in pieces.vertices())
     assert result["pieces"] == 7 and result["ok"] and result["face_strain"] == [0.0] * 7
-    assert result["key"] == key_of("pattern", text, {"seam_allowance": 0.0})
+    assert result["key"] == key_of("pattern", text, {"seam_allowance": 0.0}, "Cut")
     assert set(result["marks"]) == {"notch", "grain", "label"}
     assert len(brep.from_brep(result["marks"]["label"], "labels").vertices()) == len(result["labels"])
     computed = worker.ask({"op": "stats"})["result"]["computed"]
@@ -178,7 +178,9 @@ def test_the_host_side_imports_nothing_but_freecad_and_the_standard_library():
 def test_the_host_key_is_the_engines_key():
     module = _host_engine()
     text = _box_brep()
-    assert module.key_of("pattern", text, {"seam_allowance": 5.0}) == key_of("pattern", text, {"seam_allowance": 5.0})
+    assert module.key_of("pattern", text, {"seam_allowance": 5.0}, "Cut") == key_of("pattern", text,
+                                                                                 {"seam_allowance": 5.0}, "Cut")
+    assert key_of("pattern", text, {}, "Cut") != key_of("pattern", text, {}, "Cup")  # the name is in the pieces
     assert module.PROTOCOL == patterns.service.PROTOCOL
 
 
@@ -249,9 +251,22 @@ def test_freecads_user_folder_is_found_as_freecad_finds_it(tmp_path, platform, e
     assert got == (tmp_path / expected if expected.startswith("home") else Path(expected))
 
 
-def test_an_old_freecads_folder_is_used_where_only_it_exists(tmp_path):
+def test_an_old_freecads_folder_is_not_guessed(tmp_path):
+    """FreeCAD 0.20 and later use ``~/.FreeCAD`` only with KeepDeprecatedPaths: the XDG folder is theirs."""
     (tmp_path / ".FreeCAD").mkdir()
-    assert host.user_dir(None, environ={}, platform="linux", home=tmp_path) == tmp_path / ".FreeCAD"
+    assert host.user_dir(None, environ={}, platform="linux", home=tmp_path) == tmp_path / ".local/share/FreeCAD"
+
+
+def test_a_link_in_the_way_is_left_alone(tmp_path, capsys):
+    """0.1.0 had users link the repository into Mod/patterns: install and uninstall leave the link and say so."""
+    (tmp_path / "repo").mkdir()
+    (tmp_path / "Mod").mkdir()
+    (tmp_path / "Mod" / "patterns").symlink_to(tmp_path / "repo")
+    (tmp_path / "repo" / "engine.json").write_text("{}")  # even one that looks like ours
+    assert main(["freecad", "install", "--user-dir", str(tmp_path)]) == 2
+    assert "0.1.0's clone or link" in capsys.readouterr().err
+    assert main(["freecad", "uninstall", "--user-dir", str(tmp_path)]) == 2
+    assert (tmp_path / "Mod" / "patterns").is_symlink() and (tmp_path / "repo" / "engine.json").exists()
 
 
 def test_install_and_uninstall(tmp_path, capsys):
@@ -303,3 +318,19 @@ def test_the_old_freecad_module_warns_and_names_its_replacement(monkeypatch):
     assert sorted(old.__all__) == ["export", "make_blank", "make_pattern", "report_of"]
     with pytest.raises(AttributeError):
         old.flatten  # noqa: B018 - not one of the forwarded names
+
+
+def test_an_edited_table_file_is_a_new_request(tmp_path):
+    """An option naming a file (a bend table) keys the request by the file's size and time: the same text,
+    an edited file, another key (a recompute then asks the engine again)."""
+    import time
+
+    table = tmp_path / "bends.csv"
+    table.write_text("thickness,radius,angle,deduction\n2,3,90,3.9\n")
+    first = key_of("blank", "BREP", {"bend_table": str(table)}, "Part")
+    assert key_of("blank", "BREP", {"bend_table": str(table)}, "Part") == first
+    time.sleep(0.01)
+    table.write_text("thickness,radius,angle,deduction\n2,3,90,4.1\n")
+    assert key_of("blank", "BREP", {"bend_table": str(table)}, "Part") != first
+    assert _host_engine().key_of("blank", "BREP", {"bend_table": str(table)}, "Part") == \
+        key_of("blank", "BREP", {"bend_table": str(table)}, "Part")

@@ -290,7 +290,7 @@ def _share_search(result, limit, max_darts, held, options, tries):
     gap = _TIP_GAP * h
     best = (worst_strain(result), result, ())
     for k in range(1, max_darts + 1):
-        lines = dart_lines(result, k, limit)
+        lines = dart_lines(result, k, limit, avoid=_seam_vertices(held))
         longest = _longest_share(result, lines, gap)
         reach = np.array([line.reach for line in lines])
         tried = None if longest is None else _attempt(result, lines, longest * reach, held, options)
@@ -382,7 +382,7 @@ class _Plan:
     def lines(self, k: int) -> list:
         """:func:`dart_lines` of ``k`` darts on the dartless layout (made once per count)."""
         if k not in self._lines:
-            self._lines[k] = dart_lines(self.result, k, self.limit)
+            self._lines[k] = dart_lines(self.result, k, self.limit, avoid=_seam_vertices(self.held))
         return self._lines[k]
 
     def lengths(self, step: _Step):
@@ -444,12 +444,15 @@ class _Plan:
         return float(w[near].sum()) > 0.5 * float(w.sum())
 
 
-def dart_lines(result: Flattening, k: int, limit: float, *, split: bool = False) -> list:
+def dart_lines(result: Flattening, k: int, limit: float, *, split: bool = False, avoid=frozenset()) -> list:
     """``k`` dart lines on a dartless layout: start vertices spread over the stretched outline, inward normals.
 
     Along a stretch that does not close on itself, darts sit in the middle of
     ``k`` equal parts; with ``split`` (gores) they part it into ``k + 1``
-    equal parts, their ends at the stretch's ends.
+    equal parts, their ends at the stretch's ends.  A dart starts at the
+    nearest outline vertex that is not in ``avoid`` (the vertices of the held
+    seams): a mouth at a seam's end would leave the seam naming the copy of
+    its end across the mouth.
 
     Returns
     -------
@@ -475,7 +478,8 @@ def dart_lines(result: Flattening, k: int, limit: float, *, split: bool = False)
         else:
             at = (np.arange(count) + 0.5) * arc[-1] / count
         for s in at:
-            i = int(np.argmin(np.abs(arc - s)))
+            nearest = np.argsort(np.abs(arc - s), kind="stable")
+            i = next((int(j) for j in nearest if int(run[j]) not in avoid), int(nearest[0]))
             vertex = int(run[i])
             before, after = run[max(i - 2, 0)], run[min(i + 2, len(run) - 1)]
             if closed and i in (0, len(run) - 1):
@@ -484,6 +488,11 @@ def dart_lines(result: Flattening, k: int, limit: float, *, split: bool = False)
             inward = np.array([-tangent[1], tangent[0]]) / max(np.linalg.norm(tangent), 1e-300)
             lines.append(DartLine(vertex, inward, _reach(polygon, uv[vertex], inward)))
     return lines
+
+
+def _seam_vertices(held) -> frozenset:
+    """The vertices of a panel's held seams (``held``: the ``lengths`` of :func:`flatten_mesh`, or None)."""
+    return frozenset() if held is None else frozenset(np.unique(np.asarray(held[0])).tolist())
 
 
 def _polygon(result: Flattening):

@@ -383,7 +383,9 @@ class _Memory:
             r -= a * hy
         if self.pairs:
             s, y, hy = self.pairs[-1]
-            r *= dot(s, y) / dot(y, hy)
+            yhy = dot(y, hy)
+            if yhy > 0:  # H0's curvature along y: rounds to 0 where y is tiny (the spline bowl on an AMD EPYC)
+                r *= dot(s, y) / yhy
         for (s, y, _), a in zip(self.pairs, reversed(alphas)):
             r += (a - dot(y, r) / dot(y, s)) * s
         return r

@@ -7,8 +7,9 @@ installed into FreeCAD's Python; FreeCAD keeps its own numpy, and every other wo
 
 FreeCAD's user data folder: ``--user-dir``; else ``$FREECAD_USER_DATA`` or ``$FREECAD_USER_HOME`` (as
 FreeCAD takes them); else the platform's: ``$XDG_DATA_HOME/FreeCAD`` or ``~/.local/share/FreeCAD`` on
-Linux (FreeCAD 0.20, 0.21 and 1.0; ``~/.FreeCAD`` where only that exists, as older ones used),
-``~/Library/Application Support/FreeCAD`` on macOS, ``%APPDATA%\\FreeCAD`` on Windows.
+Linux (FreeCAD 0.20, 0.21 and 1.0; ``~/.FreeCAD`` only with its ``KeepDeprecatedPaths`` setting: give
+``--user-dir`` then), ``~/Library/Application Support/FreeCAD`` on macOS, ``%APPDATA%\\FreeCAD`` on
+Windows.
 """
 
 from __future__ import annotations
@@ -46,9 +47,7 @@ def user_dir(given: Path | None = None, *, environ=None, platform: str | None = 
         return Path(environ.get("APPDATA") or home / "AppData" / "Roaming") / "FreeCAD"
     if platform == "darwin":
         return home / "Library" / "Application Support" / "FreeCAD"
-    xdg = Path(environ.get("XDG_DATA_HOME") or home / ".local" / "share") / "FreeCAD"
-    legacy = home / ".FreeCAD"
-    return legacy if legacy.is_dir() and not xdg.is_dir() else xdg
+    return Path(environ.get("XDG_DATA_HOME") or home / ".local" / "share") / "FreeCAD"
 
 
 def _engine_command() -> list:
@@ -64,8 +63,9 @@ def install(user: Path | None = None) -> Path:
 
     mod = user_dir(user) / "Mod"
     target = mod / NAME
-    if target.exists() and not (target / MARK).is_file():
-        raise InputError(f"{target}: a folder that is not a patterns workbench is in the way (move it aside)")
+    if target.is_symlink() or (target.exists() and not (target / MARK).is_file()):
+        raise InputError(f"{target}: a folder that is not a patterns workbench is in the way (0.1.0's clone or link "
+                         f"of the repository? move it aside: docs/freecad.md)")
     try:
         mod.mkdir(parents=True, exist_ok=True)
         staging = Path(tempfile.mkdtemp(prefix=".patterns-", dir=mod))
@@ -76,9 +76,11 @@ def install(user: Path | None = None) -> Path:
         shutil.copytree(ADDON, folder, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
         record = {"command": _engine_command(), "version": __version__, "protocol": PROTOCOL}
         (folder / MARK).write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
-        if target.exists():
-            shutil.rmtree(target)
+        if target.exists():  # the old one aside, the new one in, then the old one gone: never neither
+            target.rename(staging / "old")
         folder.rename(target)
+    except OSError as exc:
+        raise InputError(f"{target}: cannot install there ({exc.strerror or exc})") from None
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return target
@@ -90,7 +92,11 @@ def uninstall(user: Path | None = None) -> Path | None:
     target = user_dir(user) / "Mod" / NAME
     if not target.exists():
         return None
-    if not (target / MARK).is_file():
-        raise InputError(f"{target}: not a patterns workbench (no {MARK}); left as it is")
-    shutil.rmtree(target)
+    if target.is_symlink() or not (target / MARK).is_file():
+        raise InputError(f"{target}: not a patterns workbench installed by `patterns freecad install` (no {MARK}); "
+                         f"left as it is")
+    try:
+        shutil.rmtree(target)
+    except OSError as exc:
+        raise InputError(f"{target}: cannot remove it ({exc.strerror or exc})") from None
     return target

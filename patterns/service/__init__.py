@@ -8,7 +8,7 @@ text, results as BREP text and plain numbers.
 
 :mod:`~patterns.service.schema` gives the hosts the options (one property per option of the records,
 checked by the records), :mod:`~patterns.service.work` computes, :mod:`~patterns.service.brep` turns
-shapes into text and back, :mod:`~patterns.service.install` puts a host's side into the host.
+shapes into text and back; :mod:`patterns.hosts` puts a host's side into the host.
 """
 
 from .schema import KINDS, records_of, schema

@@ -1,8 +1,8 @@
 """Shapes across the process boundary: a host's shape in, pieces out, as BREP text.
 
 BREP is the one format both sides' OpenCascades write and read exactly (FreeCAD carries its own, the
-engine OCP's, through build123d).  In, a host's shape is read by OCP from its BREP text, the way a STEP
-file is read.  Out, a piece's exact contours become edges (lines as segments, arcs as arcs, a drilled hole
+engine OCP's, through build123d).  In, a host's shape is read from its BREP text by the library's one
+reading path (:func:`patterns.reading.read_cad`), as a ``.brep`` file is.  Out, a piece's exact contours become edges (lines as segments, arcs as arcs, a drilled hole
 one circle), its cut a face with holes, at 1:1 in the XY plane; marks are edges and points.  Written as
 BREP format version 1, which every OpenCascade since 6.x reads (FreeCAD 0.20's 7.6 among them).
 """
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import shutil
 import tempfile
 
 import numpy as np
@@ -23,23 +24,26 @@ __all__ = ["from_brep", "marks", "pieces_brep", "to_brep"]
 
 
 def from_brep(text: str, label: str):
-    """The build123d shape of BREP ``text`` (a host's shape), or CadError naming ``label``."""
+    """The build123d shape of BREP ``text`` (a host's shape), read as a ``.brep`` file is
+    (:func:`patterns.reading.read_cad`: OpenCascade's complaints kept off the protocol), or CadError
+    naming ``label``."""
     import build123d
-    from OCP.BRep import BRep_Builder
-    from OCP.BRepTools import BRepTools
-    from OCP.TopoDS import TopoDS_Shape
+
+    from ..reading import read_cad
 
     if not isinstance(text, str) or not text.strip():
         raise CadError(f"{label}: no shape was sent (empty BREP text)")
-    fd, path = tempfile.mkstemp(suffix=".brep", prefix="patterns-")
+    folder = tempfile.mkdtemp(prefix="patterns-")
+    path = os.path.join(folder, "shape.brep")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as out:
+        with open(path, "w", encoding="utf-8") as out:
             out.write(text)
-        shape = TopoDS_Shape()
-        if not BRepTools.Read_s(shape, path, BRep_Builder()) or shape.IsNull():
-            raise CadError(f"{label}: its shape could not be read (not BREP text)")
+        try:
+            shape = read_cad(path)
+        except CadError as exc:
+            raise CadError(f"{label}: its shape could not be read ({str(exc).replace(path, 'BREP text')})") from None
     finally:
-        os.unlink(path)
+        shutil.rmtree(folder, ignore_errors=True)
     return build123d.Shape.cast(shape)
 
 

@@ -14,10 +14,10 @@ import sys
 import traceback
 from typing import BinaryIO
 
-from ..errors import PatternsError
+from ..errors import InputError, PatternsError
 from .work import Results, export, make, validate
 
-__all__ = ["PROTOCOL", "Server", "serve"]
+__all__ = ["PROTOCOL", "Server", "protocol_output", "serve"]
 
 PROTOCOL = 1
 """The protocol's version: a host and a worker of different protocols refuse each other, saying so."""
@@ -32,14 +32,10 @@ def _hello(request: dict) -> dict:
 
     protocol = request.get("protocol")
     if protocol != PROTOCOL:
-        raise _Refused(f"this patterns engine {__version__} speaks protocol {PROTOCOL}, the host {protocol!r}: "
+        raise InputError(f"this patterns engine {__version__} speaks protocol {PROTOCOL}, the host {protocol!r}: "
                        f"install the same version on both sides (patterns freecad install)")
     return {"engine": "patterns", "version": __version__, "protocol": PROTOCOL, "pid": os.getpid(),
             "python": sys.executable, "options": schema()}
-
-
-class _Refused(PatternsError):
-    """A request the worker will not serve (another protocol, an unknown operation)."""
 
 
 class Server:
@@ -68,7 +64,7 @@ class Server:
             elif op == "shutdown":
                 result = {}
             else:
-                raise _Refused(f"unknown operation {op!r}; the operations are hello, validate, make, export, stats, shutdown")
+                raise InputError(f"unknown operation {op!r}; the operations are hello, validate, make, export, stats, shutdown")
         except PatternsError as exc:
             return {"id": ident, "ok": False, "error": {"type": type(exc).__name__, "message": str(exc)}}
         except Exception as exc:  # noqa: BLE001 - a bug of the engine: said to the host, the worker lives on
@@ -85,13 +81,27 @@ def _decode(line: bytes) -> dict:
     return request if isinstance(request, dict) else {"op": None, "bad": "a request must be a JSON object"}
 
 
+def protocol_output() -> BinaryIO:
+    """The process's standard output, kept for the protocol; file descriptor 1 and ``sys.stdout`` then go to
+    standard error, so that nothing a library prints can come between two replies.  Called first thing."""
+    out = os.fdopen(os.dup(1), "wb")
+    os.dup2(2, 1)
+    sys.stdout = sys.stderr
+    return out
+
+
+def _too_long(stdin: BinaryIO) -> dict:
+    """Skip the rest of a line longer than :data:`MAX_LINE`: one request, one reply."""
+    while True:
+        rest = stdin.readline(MAX_LINE)
+        if not rest or rest.endswith(b"\n"):
+            return {"op": None, "bad": f"a request longer than {MAX_LINE} bytes"}
+
+
 def serve(stdin: BinaryIO | None = None, stdout: BinaryIO | None = None) -> int:
-    """Answer requests from ``stdin`` on ``stdout`` (default the process's own) until ``shutdown`` or the end
-    of the input; returns the exit code (0)."""
-    if stdout is None:  # the protocol keeps the real standard output; everything else printed goes to stderr
-        stdout = os.fdopen(os.dup(1), "wb", buffering=0)
-        os.dup2(2, 1)
-        sys.stdout = sys.stderr
+    """Answer requests from ``stdin`` on ``stdout`` (default the process's own, :func:`protocol_output`) until
+    ``shutdown`` or the end of the input; returns the exit code (0)."""
+    stdout = stdout or protocol_output()
     stdin = stdin or sys.stdin.buffer
     server = Server()
     while True:
@@ -100,7 +110,7 @@ def serve(stdin: BinaryIO | None = None, stdout: BinaryIO | None = None) -> int:
             return 0
         if not line.strip():
             continue
-        request = _decode(line)
+        request = _too_long(stdin) if len(line) == MAX_LINE and not line.endswith(b"\n") else _decode(line)
         if "bad" in request:
             reply = {"id": None, "ok": False, "error": {"type": "InputError", "message": request["bad"]}}
         else:

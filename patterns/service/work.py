@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import re
 import time
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -30,10 +32,23 @@ from .schema import records_of
 __all__ = ["Made", "Results", "export", "figures", "key_of", "make", "validate"]
 
 
-def key_of(kind: str, shape: str, options: dict) -> str:
-    """The key of a request's result: SHA-256 of its kind, shape and options (what a host hashes too)."""
-    text = json.dumps([kind, options], sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode() + b"\0" + shape.encode()).hexdigest()
+_FLAGS = re.compile(r"(?m)^[01]{7}$")
+"""A BREP shape's flags line (free, modified, checked, orientable, closed, infinite, convex): left out of keys."""
+
+
+def _stamp(path: str) -> list:
+    """A file's size and modification time: an edited table file is a new request."""
+    status = os.stat(path)
+    return [status.st_size, status.st_mtime_ns]
+
+
+def key_of(kind: str, shape: str, options: dict, name: str) -> str:
+    """The key of a request's result: SHA-256 of its kind, name, options and shape (what a host hashes too;
+    the name is in the pieces' names and labels)."""
+    files = {v: _stamp(v) for v in options.values() if isinstance(v, str) and os.path.isfile(v)}  # a bend table
+    text = json.dumps([kind, name, options, files], sort_keys=True, separators=(",", ":"))
+    geometry = _FLAGS.sub("", shape)  # a shape's state flags change when it is only displayed (tessellated)
+    return hashlib.sha256(text.encode() + b"\0" + geometry.encode()).hexdigest()
 
 
 @dataclass(frozen=True)
@@ -54,7 +69,7 @@ class Results:
         self._items: OrderedDict = OrderedDict()
 
     def get(self, kind: str, shape: str, options: dict, name: str) -> Made:
-        key = key_of(kind, shape, options)
+        key = key_of(kind, shape, options, name)
         if key in self._items:
             self._items.move_to_end(key)
             return self._items[key]
@@ -128,7 +143,7 @@ def make(results: Results, request: dict) -> dict:
     if not isinstance(n_faces, int) or n_faces < 0:
         raise InputError(f"{name}: faces must be a count, got {n_faces!r}")
     return {
-        "key": key_of(kind, shape, options),
+        "key": key_of(kind, shape, options, name),
         "shape": brep.pieces_brep(made.drawing.pieces, bends=kind == "blank"),
         "marks": marks,
         "colours": {role: layer.color for role, layer in PRESETS["patterns"].items()},

@@ -80,6 +80,7 @@ def bad_option():
         except PatternsError as exc:
             out[next(iter(options))] = str(exc)
     out["objects"] = [o.Name for o in doc.Objects]
+    out["text_number"] = make_pattern(cut, seam_allowance="5", marks=False).seam_allowance  # as a form gives it
     return out
 
 

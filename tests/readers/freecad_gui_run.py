@@ -40,6 +40,14 @@ def _yes():
         (button or widget.defaultButton()).click()
 
 
+def _field_of(panel, name):
+    """The panel's field of one option, found as a user finds it: by its label."""
+    (label,) = [w for w in panel.form.findChildren(QtGui.QLabel) if w.text() == name.replace("_", " ")]
+    form = label.parentWidget().layout()
+    row, _ = form.getWidgetPosition(label)
+    return form.itemAt(row, QtGui.QFormLayout.FieldRole).widget()
+
+
 def _grab(path):
     Gui.updateGui()
     QtGui.QApplication.primaryScreen().grabWindow(0).save(path)
@@ -84,8 +92,8 @@ def run():
     out["panel_height"] = panel.form.sizeHint().height()
     if os.environ.get("PANEL"):
         _grab(os.environ["PANEL"])
-    panel.readers["seam_allowance"].__self__.setValue(5.0)
-    panel.readers["max_strain"].__self__.setText("0.03")
+    _field_of(panel, "seam_allowance").setText("5")
+    _field_of(panel, "max_strain").setText("0.03")
     accepted = panel.accept()
     Gui.updateGui()
     computed.append(engine().request("stats")["computed"])
@@ -105,6 +113,12 @@ def run():
     Gui.Selection.addSelection(pattern)
     Gui.runCommand("Patterns_Check")
     out["check"] = out["dialogs"].pop()[2] if out["dialogs"] else ""
+    _overlay_and_delete(doc, cut, pattern)
+
+
+def _overlay_and_delete(doc, cut, pattern):
+    """The strain overlay on, off, on again; the pattern deleted (FreeCAD's question answered yes); then
+    FreeCAD's own Unwrap Mesh, the docs' picture and the modules of this process."""
     colours = {"own": _colours(cut)}
     pattern.ShowStrain = True
     colours["strain"] = _colours(cut)
@@ -147,7 +161,6 @@ def _picture(path):
     """docs/freecad.md's picture: the four-panel cup sample, its pattern beside it (10 mm seam allowance,
     checked at 15 %), the strain overlay on the cup."""
     import Part
-
     from freecad.patterns_wb import make_pattern
 
     doc = FreeCAD.newDocument("cup")

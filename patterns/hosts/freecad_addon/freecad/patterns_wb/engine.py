@@ -12,6 +12,8 @@ import atexit
 import hashlib
 import json
 import os
+import queue
+import re
 import shlex
 import subprocess
 import sys
@@ -20,6 +22,9 @@ import threading
 
 PROTOCOL = 1
 """The protocol this host side speaks."""
+HELLO = 120.0
+"""Seconds a starting worker has to answer ``hello`` (its imports take about 3 s); a request has no limit:
+a flattening takes what it takes."""
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ICONS = os.path.join(HERE, "resources", "icons")
@@ -52,7 +57,9 @@ def configured():
     EngineError saying what to run."""
     text = os.environ.get("PATTERNS_ENGINE", "").strip()
     if text:
-        return shlex.split(text, posix=os.name != "nt")  # on Windows C:\path\python.exe keeps its backslashes
+        if os.name != "nt":
+            return shlex.split(text)
+        return [t[1:-1] if len(t) > 1 and t[0] == t[-1] == '"' else t for t in shlex.split(text, posix=False)]
     try:
         with open(CONFIG, encoding="utf-8") as f:
             command = json.load(f)["command"]
@@ -87,11 +94,23 @@ def _environment():
     return env
 
 
-def key_of(kind, shape, options):
+_FLAGS = re.compile(r"(?m)^[01]{7}$")
+"""A BREP shape's flags line (free, modified, checked, orientable, closed, infinite, convex): left out of keys."""
+
+
+def _stamp(path):
+    """A file's size and modification time: an edited table file is a new request."""
+    status = os.stat(path)
+    return [status.st_size, status.st_mtime_ns]
+
+
+def key_of(kind, shape, options, name):
     """The key of a request's result (the engine's ``patterns.service.work.key_of``): unchanged key, unchanged
     pieces."""
-    text = json.dumps([kind, options], sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode() + b"\0" + shape.encode()).hexdigest()
+    files = {v: _stamp(v) for v in options.values() if isinstance(v, str) and os.path.isfile(v)}  # a bend table
+    text = json.dumps([kind, name, options, files], sort_keys=True, separators=(",", ":"))
+    geometry = _FLAGS.sub("", shape)  # a shape's state flags change when it is only displayed (tessellated)
+    return hashlib.sha256(text.encode() + b"\0" + geometry.encode()).hexdigest()
 
 
 class Engine:
@@ -104,6 +123,7 @@ class Engine:
         self.starts = 0
         self.log = None
         self._next = 0
+        self._lines = None
         self._lock = threading.Lock()
 
     @property
@@ -124,15 +144,18 @@ class Engine:
         fd, self.log = tempfile.mkstemp(prefix="patterns-engine-", suffix=".log")
         try:
             self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=fd,
-                                            env=_environment(), close_fds=True)
+                                            env=_environment(), close_fds=True,
+                                            creationflags=getattr(subprocess, "CREATE_NO_WINDOW", 0))
         except OSError as exc:
             raise EngineError(f"the patterns engine could not be started ({shlex.join(command)}: {exc}): "
                               f"{INSTALL_HINT}") from None
         finally:
             os.close(fd)
         self.starts += 1
+        self._lines = queue.Queue()
+        threading.Thread(target=_read_lines, args=(self.process.stdout, self._lines), daemon=True).start()
         try:
-            self.hello = self._exchange({"op": "hello", "protocol": PROTOCOL, "host": "freecad"})
+            self.hello = self._exchange({"op": "hello", "protocol": PROTOCOL, "host": "freecad"}, timeout=HELLO)
         except Refused as exc:  # another protocol: said in one line
             self.stop()
             raise EngineError(str(exc)) from None
@@ -146,18 +169,28 @@ class Engine:
                              f"{self.hello['version']}: run `patterns freecad install` again from the engine's "
                              f"environment\n")
 
-    def _exchange(self, message):
+    def _exchange(self, message, timeout=None):
+        """Send one request, wait for its reply (``timeout`` s at most, else the worker is ended); a reply that
+        is not JSON or not this request's ends the worker too (:class:`_Died`: it is started again)."""
         self._next += 1
         message = dict(message, id=self._next)
         try:
             self.process.stdin.write(json.dumps(message, separators=(",", ":")).encode() + b"\n")
             self.process.stdin.flush()
-            line = self.process.stdout.readline()
+            line = self._lines.get(timeout=timeout)
         except (BrokenPipeError, OSError):
             line = b""
-        if not line:
-            raise _Died(self._tail())
-        reply = json.loads(line)
+        except queue.Empty:
+            self.process.kill()
+            raise _Died(f"no answer in {timeout:.0f} s\n{self._tail()}") from None
+        try:
+            reply = json.loads(line) if line else None
+        except ValueError:
+            reply = None
+        if not isinstance(reply, dict) or reply.get("id") != message["id"]:
+            if self.process.poll() is None:
+                self.process.kill()
+            raise _Died(self._tail() if not line else f"a reply that is not the answer: {line[:200]!r}\n{self._tail()}")
         if not reply.get("ok"):
             error = reply.get("error") or {}
             raise Refused(error.get("type", "Error"), error.get("message", "the engine failed"),
@@ -203,6 +236,13 @@ class Engine:
             except OSError:
                 pass
             self.log = None
+
+
+def _read_lines(stream, lines):
+    """The worker's replies, a line each, into ``lines`` (``b""`` at the end)."""
+    for line in iter(stream.readline, b""):
+        lines.put(line)
+    lines.put(b"")
 
 
 class _Died(Exception):

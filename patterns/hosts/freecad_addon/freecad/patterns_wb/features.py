@@ -11,6 +11,7 @@ calls the engine.  Each kind of mark is a child object (``Marks``) in the object
 """
 
 import json
+import os
 
 import FreeCAD
 import Part
@@ -18,7 +19,7 @@ import Part
 from . import properties
 from .engine import EngineError, engine, key_of
 from .properties import PatternsError, check_options
-from .proxies import Stateless
+from .proxies import Stateless, marks_of
 
 ROLES = ("sew", "notch", "grain", "drill", "bend_up", "bend_down", "bend", "label")
 """The kinds of mark a ``Marks`` child holds, one each."""
@@ -74,24 +75,27 @@ class _Feature(Stateless):
         self.marks, self.labels, self.colours = None, [], {}
 
     def request(self, obj):
-        """``(key, request fields)`` of the object as it is now."""
+        """``(key, request fields)`` of the object as it is now (from the object alone: no engine)."""
         shape, faces = _source(obj)
-        options = properties.changed(obj, engine().options[self.KIND])
+        options, name = properties.changed(obj), obj.Source[0].Label
+        options = {k: os.path.abspath(v) if isinstance(v, str) and os.path.isfile(v) else v  # a table: FreeCAD's
+                   for k, v in options.items()}                                                # folder, not the engine's
         text = shape.exportBrepToString()
-        return key_of(self.KIND, text, options), {"kind": self.KIND, "shape": text, "options": options,
-                                                  "name": obj.Source[0].Label, "faces": faces}
+        return key_of(self.KIND, text, options, name), {"kind": self.KIND, "shape": text, "options": options,
+                                                        "name": name, "faces": faces}
 
     def execute(self, obj):
         try:
             key, fields = self.request(obj)
             if key == obj.Key and not obj.Shape.isNull():
-                obj.Shape = _placed(obj.Shape, obj.Placement)  # moved or reopened: the same pieces
+                obj.Shape = _placed(obj.Shape, obj.Placement)  # moved or reopened: the same pieces, no engine
                 return
+            properties.add(obj, engine().options[self.KIND])  # an engine upgraded since: its new options
             result = engine().request("make", **fields)
-        except (EngineError, PatternsError) as exc:
+            self.apply(obj, key, result)
+        except Exception as exc:  # noqa: BLE001 - the engine's word, or a shape FreeCAD cannot read: the recompute fails
             FreeCAD.Console.PrintError(f"patterns: {exc}\n")
             raise PatternsError(str(exc)) from None
-        self.apply(obj, key, result)
 
     def apply(self, obj, key, result):
         """The engine's result on the object: shape, marks, report."""
@@ -145,7 +149,8 @@ class PatternFeature(_Feature):
         obj.FaceStrain = result["face_strain"]
 
     def onChanged(self, obj, prop):
-        if prop in ("ShowStrain", "FaceStrain") and "SourceColours" in obj.PropertiesList:
+        if prop in ("ShowStrain", "FaceStrain") and "SourceColours" in obj.PropertiesList \
+            and "Restore" not in obj.State:  # while a document is read, its colours are the saved ones
             from .views import show_strain
 
             show_strain(obj)
@@ -215,14 +220,13 @@ def _make(kind, source, name, marks, options):
         if marks:
             _add_marks(doc, obj)
             doc.recompute()
-    except (PatternsError, EngineError, ValueError) as exc:
+    except Exception as exc:  # noqa: BLE001 - whatever failed, the document is left as it was
         if obj is not None:
-            for child in [doc.getObject(n) for n in obj.Marks]:
-                if child is not None:
-                    doc.removeObject(child.Name)
+            for child in marks_of(obj):
+                doc.removeObject(child.Name)
             doc.removeObject(obj.Name)
         doc.abortTransaction()
-        raise exc if isinstance(exc, PatternsError) else PatternsError(str(exc)) from None
+        raise exc if isinstance(exc, PatternsError) else PatternsError(f"{name}: {exc}") from None
     doc.commitTransaction()
     from .views import view_pieces
 
@@ -268,7 +272,7 @@ def export(obj, path, **options):
     proxy = _proxy(obj)
     try:
         _, fields = proxy.request(obj)
-        engine().request("export", path=str(path), write=options, **fields)
+        engine().request("export", path=os.path.abspath(str(path)), write=options, **fields)  # FreeCAD's folder
     except EngineError as exc:
         raise PatternsError(str(exc)) from None
 

@@ -28,14 +28,19 @@ def _field(p, current):
         widget.setRange(int(max(low, -10**9)), int(min(high, 10**9)))
         widget.setValue(int(current))
         return widget, widget.value
-    if p["kind"] == "float":
-        widget = QtGui.QDoubleSpinBox()
-        widget.setDecimals(6)
-        widget.setRange(-1e9, 1e9)
-        widget.setValue(float(current))
-        return widget, widget.value
+    if p["kind"] == "float":  # text, not a spin box: 1e-07 keeps its digits
+        widget = QtGui.QLineEdit(repr(float(current)))
+        return widget, lambda: _number(widget.text())
     widget = QtGui.QLineEdit(str(current))
     return widget, widget.text
+
+
+def _number(text):
+    """A float field's value: the number, or the text as it is (the engine's records then say what is wrong)."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
 
 
 class OptionsPanel:
@@ -116,8 +121,8 @@ class CreatePanel(OptionsPanel):
 
 
 class EditPanel(OptionsPanel):
-    """An object's options (double-click): OK sets them and recomputes it once; a refused value leaves the
-    object as it was."""
+    """An object's options (double-click): OK sets them and recomputes it once, one undo step; a value the
+    engine refuses, or a recompute that fails, leaves the object as it was."""
 
     def __init__(self, obj):
         from .engine import engine
@@ -130,12 +135,22 @@ class EditPanel(OptionsPanel):
     def apply(self, values):
         from .properties import PatternsError, check_options
 
-        check_options(self.obj.Proxy.KIND, values, self.obj.Label)
+        obj, doc = self.obj, self.obj.Document
+        check_options(obj.Proxy.KIND, values, obj.Label)
+        before = {p["name"]: properties.value(obj, p) for p in self.schema if p["name"] in obj.PropertiesList}
         defaults = {p["name"]: p["default"] for p in self.schema}
-        properties.set_values(self.obj, self.schema, dict(defaults, **values), self.obj.Label)
-        self.obj.Document.recompute()
-        if not self.obj.isValid():
-            raise PatternsError(f"{self.obj.Label}: {self.obj.getStatusString()}")
+        doc.openTransaction(f"patterns: options of {obj.Label}")
+        try:
+            properties.set_values(obj, self.schema, dict(defaults, **values), obj.Label)
+            doc.recompute()
+            if not obj.isValid():
+                raise PatternsError(f"{obj.Label}: {obj.getStatusString()}")
+        except Exception:
+            properties.set_values(obj, self.schema, before, obj.Label)
+            doc.abortTransaction()
+            doc.recompute()
+            raise
+        doc.commitTransaction()
 
     def close(self):
         import FreeCADGui as Gui

@@ -1,5 +1,5 @@
-"""What FreeCAD keeps of a Python proxy in a saved document: nothing (every proxy here is made again from the
-object's properties when the document is opened)."""
+"""What the proxies share: FreeCAD keeps nothing of them in a saved document (each is made again from its
+object's properties when the document is opened), and a pattern's marks are found by their link to it."""
 
 
 class Stateless:
@@ -19,3 +19,8 @@ class Stateless:
 
     def __setstate__(self, state):
         self.loads(state)
+
+
+def marks_of(obj):
+    """The Marks objects of a pattern or blank: those whose ``Base`` it is (a pasted copy's are its own)."""
+    return [o for o in obj.InList if "Role" in o.PropertiesList and getattr(o, "Base", None) == obj]

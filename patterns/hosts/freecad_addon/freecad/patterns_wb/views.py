@@ -7,7 +7,7 @@ import os
 import FreeCAD
 
 from .engine import ICONS
-from .proxies import Stateless
+from .proxies import Stateless, marks_of
 
 _ACI = {1: (1.0, 0.0, 0.0), 2: (0.8, 0.7, 0.0), 3: (0.0, 0.6, 0.0), 4: (0.0, 0.7, 0.7), 5: (0.0, 0.0, 1.0),
         6: (0.8, 0.0, 0.8), 7: (0.1, 0.1, 0.1)}
@@ -29,8 +29,7 @@ class ViewPieces(Stateless):
         self.Object = view.Object
 
     def claimChildren(self):
-        doc = self.Object.Document
-        return [doc.getObject(name) for name in self.Object.Marks if doc.getObject(name) is not None]
+        return marks_of(self.Object)
 
     def getIcon(self):
         return os.path.join(ICONS, "flatten.svg" if self.Object.Proxy.KIND == "pattern" else "unfold.svg")
@@ -43,7 +42,7 @@ class ViewPieces(Stateless):
 
     def setEdit(self, view, mode=0):
         if mode != 0:
-            return False  # the transform dragger and the others stay FreeCAD's
+            return None  # the transform dragger and the other modes: FreeCAD's own
         import FreeCADGui as Gui
 
         from .panels import EditPanel
@@ -77,6 +76,9 @@ class ViewMarks(ViewPieces):
 
     def doubleClicked(self, view):
         return False
+
+    def setEdit(self, view, mode=0):
+        return None  # FreeCAD's own (a Marks object has no options)
 
     def onDelete(self, view, subelements):
         return True
@@ -123,8 +125,9 @@ def show_strain(obj):
     if not obj.SourceColours:
         obj.SourceColours = json.dumps([list(c) for c in source.ViewObject.DiffuseColor])
     limit = _limit(obj)
+    own = [tuple(c) for c in json.loads(obj.SourceColours)] or [(0.8, 0.8, 0.8, 0.0)]
     colours = []
-    for strain in obj.FaceStrain:
-        t = min(max(strain / limit, 0.0), 1.0)
-        colours.append((1.0, 1.0 - t, 1.0 - t, 0.0))
+    for i, strain in enumerate(obj.FaceStrain):
+        t = min(max(strain / limit, 0.0), 1.0)  # the 4th value as the part's own (transparency, or 1.0's alpha)
+        colours.append((1.0, 1.0 - t, 1.0 - t, own[min(i, len(own) - 1)][3]))
     source.ViewObject.DiffuseColor = colours
