@@ -334,3 +334,20 @@ def test_an_edited_table_file_is_a_new_request(tmp_path):
     assert key_of("blank", "BREP", {"bend_table": str(table)}, "Part") != first
     assert _host_engine().key_of("blank", "BREP", {"bend_table": str(table)}, "Part") == \
         key_of("blank", "BREP", {"bend_table": str(table)}, "Part")
+
+
+def test_a_mesh_is_sent_as_arrays_and_flattened_as_the_api_flattens_it(worker):
+    """``mesh`` instead of ``shape`` (a host whose model is a mesh: Blender next): the piece's area is the API's
+    panel's (``mesh_model`` of the same arrays), read back from the reply's BREP; a blank of a mesh is refused."""
+    from patterns import surfaces
+    from patterns.reading import mesh_model
+
+    vertices, faces = surfaces.paraboloid_dish(diameter=600, sag=54, n_faces=2000)
+    mesh = {"vertices": vertices.tolist(), "faces": faces.tolist()}
+    reply = worker.ask({"id": 20, "op": "make", "kind": "pattern", "name": "dish", "mesh": mesh, "options": {}})
+    assert reply["ok"], reply
+    (piece,) = brep.from_brep(reply["result"]["shape"], "reply").faces()
+    (panel,) = patterns.flatten(mesh_model(vertices, faces, name="dish")).panels
+    assert piece.area == pytest.approx(panel.area, rel=1e-9)
+    refused = worker.ask({"id": 21, "op": "make", "kind": "blank", "name": "dish", "mesh": mesh, "options": {}})
+    assert "unfolded from a CAD shape" in refused["error"]["message"]

@@ -16,6 +16,8 @@ import time
 from collections import OrderedDict
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..audit import CheckOptions, Report, checked_drawing
 from ..errors import InputError
 from ..export import WriteOptions, write
@@ -24,6 +26,7 @@ from ..flattening import FlattenOptions, flatten
 from ..nesting import NestOptions, layout
 from ..pattern import Pattern
 from ..pieces import Drawing, PieceOptions, drawing_of, piece_labels
+from ..reading import mesh_model
 from ..sheetmetal import UnfoldOptions, unfold
 from ..tessellate import MeshingOptions, mesh_shape
 from . import brep
@@ -83,11 +86,17 @@ class Results:
 
 def _compute(kind: str, shape: str, options: dict, name: str) -> Made:
     records = records_of(kind, options, name=name)  # every option checked before the shape is read
-    source = brep.from_brep(shape, name)
-    if kind == "pattern":
-        subject = flatten(mesh_shape(source, records[MeshingOptions], name=name), records[FlattenOptions])
+    if shape.startswith("{"):  # a mesh (its arrays as JSON: see _fields), never BREP text
+        if kind != "pattern":
+            raise InputError(f"{name}: a blank is unfolded from a CAD shape (BREP), not a mesh")
+        mesh = json.loads(shape)
+        model = mesh_model(np.asarray(mesh["vertices"], dtype=np.float64), np.asarray(mesh["faces"]), name=name)
+        subject = flatten(model, records[FlattenOptions])
+    elif kind == "pattern":
+        model = mesh_shape(brep.from_brep(shape, name), records[MeshingOptions], name=name)
+        subject = flatten(model, records[FlattenOptions])
     else:
-        subject = unfold(source, records[UnfoldOptions], name=name)
+        subject = unfold(brep.from_brep(shape, name), records[UnfoldOptions], name=name)
     nesting = records[NestOptions]
     if nesting.active:
         drawing = layout(subject, nesting, pieces=records[PieceOptions]).drawing()
@@ -187,6 +196,11 @@ def _fields(request: dict) -> tuple:
     kind, shape, options = request.get("kind"), request.get("shape"), request.get("options") or {}
     if not isinstance(kind, str):
         raise InputError(f"{name}: kind must be 'pattern' or 'blank'")
-    if not isinstance(shape, str):
-        raise InputError(f"{name}: shape must be BREP text")
+    mesh = request.get("mesh")
+    if mesh is not None:  # a mesh instead of a shape: {"vertices": (n, 3) mm, "faces": (m, 3) indices}
+        if not isinstance(mesh, dict) or not {"vertices", "faces"} <= set(mesh):
+            raise InputError(f"{name}: mesh must be an object with vertices (n x 3, mm) and faces (m x 3)")
+        shape = json.dumps({"vertices": mesh["vertices"], "faces": mesh["faces"]}, separators=(",", ":"))
+    if not isinstance(shape, str) or shape.startswith("{") and mesh is None:
+        raise InputError(f"{name}: shape must be BREP text (or give a mesh)")
     return kind, shape, options, name
