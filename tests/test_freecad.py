@@ -93,6 +93,8 @@ def test_a_cut_flattens_in_its_document_and_grows_with_its_box(tmp_path):
     assert result["z"] == 0.0 and result["ok"] and result["pieces"] == 7
     assert result["face_strain"] == [0.0] * 7  # every face an exact development
     moved, marks_moved = result["moved"], result["marks_moved"]  # moved 450 mm down, and its marks with it
+    gap, level = result["beside"]  # laid beside the cut, to its +X side, level with its lowest point
+    assert gap > 0 and level == pytest.approx(0, abs=1e-9)
     assert moved[1] == pytest.approx(result["laid"] - 450, abs=1e-9)
     assert moved[0] <= marks_moved[0] and moved[1] <= marks_moved[1]
     assert marks_moved[2] <= moved[2] and marks_moved[3] <= moved[3]
@@ -202,6 +204,8 @@ def test_a_seam_allowance_set_later_adds_the_sew_lines(tmp_path):
     result = _run("allowance_later", tmp_path)
     assert "sew" in result["before"] and result["after"] == result["before"]
     assert result["sew_edges"] > 0
+    valid, ok, report = result["bad_later"]  # then made bad: the recompute fails and says why
+    assert not valid and not ok and report.startswith("recompute failed: Cut: seam_allowance (mm) must be")
 
 
 def test_without_an_engine_one_error_says_what_to_run_and_it_works_once_there(tmp_path):

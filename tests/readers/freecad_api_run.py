@@ -54,7 +54,8 @@ def box_minus_cylinder(step):
     made = _computed()
     before = _faces(pattern)
     laid = pattern.Shape.BoundBox.YMin
-    pattern.Placement.Base = FreeCAD.Vector(0, -450, 0)
+    beside = [pattern.Shape.BoundBox.XMin - cut.Shape.BoundBox.XMax, laid - cut.Shape.BoundBox.YMin]
+    pattern.Placement.Base = pattern.Placement.Base + FreeCAD.Vector(0, -450, 0)
     doc.recompute()
     moved = _computed()
     z = max(abs(v.Z) for v in pattern.Shape.Vertexes)
@@ -67,7 +68,7 @@ def box_minus_cylinder(step):
     return {"areas": before, "after": _faces(pattern), "ok": pattern.Ok, "pieces": pattern.Pieces,
             "face_strain": list(pattern.FaceStrain), "marks": _marks(doc, pattern), "report": pattern.Report,
             "z": z, "computed": [made, moved, _computed()], "moved": moved_box, "marks_moved": marks_box,
-            "laid": laid}
+            "laid": laid, "beside": beside}
 
 
 def bad_option():
@@ -190,8 +191,11 @@ def allowance_later():
     pattern.seam_allowance = 5.0
     doc.recompute()
     sew = [doc.getObject(n) for n in pattern.Marks if doc.getObject(n).Role == "sew"]
-    return {"before": roles, "after": sorted(doc.getObject(n).Role for n in pattern.Marks),
-            "sew_edges": len(sew[0].Shape.Edges) if sew else 0}
+    sew_edges = len(sew[0].Shape.Edges) if sew else 0
+    pattern.seam_allowance = -3.0  # made bad later: the recompute fails, and the verdict says so
+    doc.recompute()
+    return {"before": roles, "after": sorted(doc.getObject(n).Role for n in pattern.Marks), "sew_edges": sew_edges,
+            "bad_later": [pattern.isValid(), pattern.Ok, pattern.Report]}
 
 
 def engine_missing():

@@ -36,7 +36,8 @@ INSTALL_HINT = ("install the engine in an environment of its own and put the wor
                 "clone of patterns:\n"
                 "    python3 -m venv .venv && .venv/bin/pip install .\n"
                 "    .venv/bin/patterns freecad install\n"
-                "(docs/freecad.md); FreeCAD need not be restarted")
+                "(docs/freecad.md; or set PATTERNS_ENGINE to the engine's command line, e.g. "
+                "\"/path/to/python -m patterns\"); FreeCAD need not be restarted")
 """The commands a user runs where the engine cannot be found or started."""
 
 

@@ -95,6 +95,7 @@ class _Feature(Stateless):
             self.apply(obj, key, result)
         except Exception as exc:  # noqa: BLE001 - the engine's word, or a shape FreeCAD cannot read: the recompute fails
             FreeCAD.Console.PrintError(f"patterns: {exc}\n")
+            obj.Ok, obj.Report = False, f"recompute failed: {exc}"  # not the last good one's verdict
             raise PatternsError(str(exc)) from None
 
     def apply(self, obj, key, result):
@@ -186,6 +187,16 @@ class MarksFeature(Stateless):
         obj.Texts = texts
 
 
+def _beside(obj, source):
+    """A new pattern or blank laid beside its source, to its +X side (not under it), its lowest piece level
+    with the source's lowest point."""
+    part, pieces = source.Shape.BoundBox, obj.Shape.BoundBox
+    if part.isValid() and pieces.isValid():
+        gap = 0.1 * max(part.XLength, part.YLength, 10.0)
+        obj.Placement.Base = FreeCAD.Vector(part.XMax + gap - pieces.XMin, part.YMin - pieces.YMin, 0)
+        obj.Document.recompute()
+
+
 def _add_marks(doc, obj):
     for role in ROLES_OF[obj.Proxy.KIND]:
         child = doc.addObject("Part::FeaturePython", f"{obj.Name}_{role}")
@@ -217,6 +228,7 @@ def _make(kind, source, name, marks, options):
         doc.recompute()
         if not obj.isValid():
             raise PatternsError(f"{obj.Label}: {obj.getStatusString()}")
+        _beside(obj, source)
         if marks:
             _add_marks(doc, obj)
             doc.recompute()

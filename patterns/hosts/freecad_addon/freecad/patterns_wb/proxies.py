@@ -23,4 +23,5 @@ class Stateless:
 
 def marks_of(obj):
     """The Marks objects of a pattern or blank: those whose ``Base`` it is (a pasted copy's are its own)."""
-    return [o for o in obj.InList if "Role" in o.PropertiesList and getattr(o, "Base", None) == obj]
+    found = {o.Name: o for o in obj.InList if "Role" in o.PropertiesList and getattr(o, "Base", None) == obj}
+    return list(found.values())  # once each: a Marks object links its base twice (Base, and its Placement)
