@@ -351,3 +351,18 @@ def test_a_mesh_is_sent_as_arrays_and_flattened_as_the_api_flattens_it(worker):
     assert piece.area == pytest.approx(panel.area, rel=1e-9)
     refused = worker.ask({"id": 21, "op": "make", "kind": "blank", "name": "dish", "mesh": mesh, "options": {}})
     assert "unfolded from a CAD shape" in refused["error"]["message"]
+
+
+def test_a_shape_only_displayed_keeps_its_key():
+    """FreeCAD flips a shape's flags line when it merely tessellates it for display (0111000 -> 0101000,
+    measured on a Part sphere): the key leaves the flags out, so a displayed part is not a new request."""
+    import re
+
+    text = _box_brep()
+    flags = re.findall(r"(?m)^[01]{7}$", text)
+    assert flags  # every shape of the BREP has its flags line
+    shown = re.sub(r"(?m)^([01])1([01]{5})$", r"\g<1>0\g<2>", text)
+    assert shown != text
+    assert key_of("pattern", shown, {}, "Cut") == key_of("pattern", text, {}, "Cut")
+    assert _host_engine().key_of("pattern", shown, {}, "Cut") == key_of("pattern", text, {}, "Cut")
+    assert key_of("pattern", text.replace("200", "201", 1), {}, "Cut") != key_of("pattern", text, {}, "Cut")
