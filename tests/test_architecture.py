@@ -145,3 +145,22 @@ def test_no_type_is_erased_and_no_type_is_guessed():
             if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "hasattr":
                 guessed.append(f"{path.name}:{node.lineno}")
     assert not erased and not guessed, (erased, guessed)
+
+
+def test_every_module_is_named_in_the_architecture_doc():
+    """docs/architecture.md names every module of the package -- a top-level one as ``name.py``, one in a
+    sub-package by its name -- so that the map of the house is the house (FreeCAD's workbench, copied into
+    FreeCAD, is named as its folder)."""
+    import re
+
+    text = (PACKAGE.parent / "docs" / "architecture.md").read_text()
+    missing = []
+    for path in _sources():
+        rel = path.relative_to(PACKAGE)
+        if path.stem == "__init__" or "freecad_addon" in rel.parts:
+            continue
+        named = f"{path.stem}.py" in text if len(rel.parts) == 1 else re.search(rf"\b{path.stem}\b", text)
+        if not named:
+            missing.append(str(rel))
+    assert "freecad_addon/" in text
+    assert not missing, missing

@@ -56,9 +56,6 @@ __all__ = ["BY_NAME", "ENERGIES", "Arap", "EdgeLengths", "Frames", "Hybrid", "In
            "dot", "frames"]
 
 
-ENERGIES = ("auto", "arap", "hybrid", "symmetric-dirichlet")
-"""The energies the relaxation takes (``"auto"``: ARAP, or the hybrid where ARAP crushes triangles)."""
-
 
 def dot(a: np.ndarray, b: np.ndarray) -> float:
     """Sum of the elementwise product of two arrays of one shape.
@@ -421,4 +418,9 @@ class EdgeLengths:
 
 
 BY_NAME = {"arap": Arap, "hybrid": Hybrid, "symmetric-dirichlet": SymmetricDirichlet}
-"""The distortion energies by their ``name`` (every one of :data:`ENERGIES` but ``"auto"``)."""
+"""The distortion energies by their ``name`` (every one of :data:`ENERGIES` but ``"auto"``): a new energy's one
+line besides its class."""
+ENERGIES = ("auto", *BY_NAME)
+"""The energies the relaxation takes (``"auto"``: ARAP, or the hybrid where ARAP crushes triangles): made
+from :data:`BY_NAME`, so a new energy's name is one line there."""
+
