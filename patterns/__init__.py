@@ -20,6 +20,7 @@ The public API, all importable from the top level::
     result = patterns.batch("parts/", "out/", jobs=2)  # a folder of parts: a row each
 """
 
+from . import deprecated  # noqa: F401 - 0.1.0's Pattern.to_dxf, Pattern.layout, Report.to_json: warn, work, go in 0.3.0
 from .audit import CheckOptions, DartReport, PanelReport, Report, SeamReport, check
 from .batching import BatchOptions, BatchResult, Row, batch
 from .blank import Bend, Blank

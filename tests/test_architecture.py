@@ -164,3 +164,39 @@ def test_every_module_is_named_in_the_architecture_doc():
             missing.append(str(rel))
     assert "freecad_addon/" in text
     assert not missing, missing
+
+
+_DEPRECATED = r"goes in 0\.3\.0: use patterns\."
+
+
+@pytest.fixture(scope="module")
+def duct():
+    return patterns.flatten(patterns.load(PACKAGE.parent / "samples" / "duct_transition.step"))
+
+
+def test_pattern_to_dxf_warns_and_writes_what_write_writes(duct, tmp_path):
+    """0.1.0's public methods, removed without a word while 0.2.0 was made, are back for one minor version:
+    each warns with its replacement and does what it did (here: the file read back against ``write``'s)."""
+    import ezdxf
+
+    with pytest.warns(DeprecationWarning, match=_DEPRECATED):
+        duct.to_dxf(tmp_path / "old.dxf", seam_allowance=5)
+    patterns.write(duct, tmp_path / "new.dxf", seam_allowance=5)
+    kinds = [sorted((e.dxftype(), e.dxf.layer) for e in ezdxf.readfile(tmp_path / f).modelspace())
+             for f in ("old.dxf", "new.dxf")]
+    assert kinds[0] == kinds[1] and kinds[0]
+
+
+def test_pattern_layout_warns_and_nests(duct):
+    with pytest.warns(DeprecationWarning, match=_DEPRECATED):
+        nest = duct.layout(width=1500, time_limit=1)
+    assert len(nest.drawing().pieces) == len(duct.panels) and nest.length > 0
+
+
+def test_report_to_json_warns_and_writes_the_report(duct, tmp_path):
+    import json
+
+    report = patterns.check(duct)
+    with pytest.warns(DeprecationWarning, match=_DEPRECATED):
+        report.to_json(tmp_path / "report.json")
+    assert json.loads((tmp_path / "report.json").read_text()) == json.loads(json.dumps(report.to_dict()))
