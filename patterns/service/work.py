@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..audit import CheckOptions, Report, checked_drawing
+from ..blank import Blank
 from ..errors import InputError
 from ..export import WriteOptions, write
 from ..export.layers import PRESETS
@@ -56,9 +57,11 @@ def key_of(kind: str, shape: str, options: dict, name: str) -> str:
 
 @dataclass(frozen=True)
 class Made:
-    """One computed object: the subject (a Pattern or a Blank), its drawing, the checked drawing, the report."""
+    """One computed object: its request's key, the subject (a Pattern or a Blank), its drawing, the checked
+    drawing, the report."""
 
-    subject: Pattern | object
+    key: str
+    subject: Pattern | Blank
     drawing: Drawing
     checked: Drawing
     report: Report
@@ -76,7 +79,7 @@ class Results:
         if key in self._items:
             self._items.move_to_end(key)
             return self._items[key]
-        made = _compute(kind, shape, options, name)
+        made = _compute(kind, shape, options, name, key)
         self.computed += 1
         self._items[key] = made
         while len(self._items) > self.size:
@@ -84,7 +87,7 @@ class Results:
         return made
 
 
-def _compute(kind: str, shape: str, options: dict, name: str) -> Made:
+def _compute(kind: str, shape: str, options: dict, name: str, key: str = "") -> Made:
     records = records_of(kind, options, name=name)  # every option checked before the shape is read
     if shape.startswith("{"):  # a mesh (its arrays as JSON: see _fields), never BREP text
         if kind != "pattern":
@@ -103,7 +106,7 @@ def _compute(kind: str, shape: str, options: dict, name: str) -> Made:
     else:
         drawing = drawing_of(subject, records[PieceOptions])
     report, checked = checked_drawing(subject, drawing, records[CheckOptions])
-    return Made(subject, drawing, checked, report)
+    return Made(key, subject, drawing, checked, report)
 
 
 def _face_strain(made: Made, n_faces: int) -> list:
@@ -152,7 +155,7 @@ def make(results: Results, request: dict) -> dict:
     if not isinstance(n_faces, int) or n_faces < 0:
         raise InputError(f"{name}: faces must be a count, got {n_faces!r}")
     return {
-        "key": key_of(kind, shape, options, name),
+        "key": made.key,  # hashed once, by Results.get
         "shape": brep.pieces_brep(made.drawing.pieces, bends=kind == "blank"),
         "marks": marks,
         "colours": {role: layer.color for role, layer in PRESETS["patterns"].items()},
