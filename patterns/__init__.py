@@ -24,6 +24,7 @@ from . import deprecated  # noqa: F401 - 0.1.0's Pattern.to_dxf, Pattern.layout,
 from .audit import CheckOptions, DartReport, PanelReport, Report, SeamReport, check
 from .batching import BatchOptions, BatchResult, Row, batch
 from .blank import Bend, Blank
+from .bundle import Bundle
 from .comparison import BlankComparison, compare_blank, read_flat_pattern
 from .cut import Cut, cut_to_disk
 from .errors import (
@@ -57,21 +58,22 @@ __version__ = "0.2.0"
 __all__ = [
     "ENERGIES",
     "METHODS",
-    "Bend",
     "BatchOptions",
     "BatchResult",
+    "Bend",
     "BendTable",
     "Blank",
     "BlankComparison",
     "Bookkeeping",
+    "Bundle",
     "CadError",
     "CheckOptions",
     "Code",
     "Connectivity",
     "Cut",
     "Dart",
-    "DartSearch",
     "DartReport",
+    "DartSearch",
     "Distortion",
     "Drawing",
     "Ease",
@@ -88,15 +90,15 @@ __all__ = [
     "LoadOptions",
     "MeshTopologyError",
     "MeshingOptions",
-    "NestOptions",
     "Model",
+    "NestOptions",
     "Overlap",
     "Panel",
     "PanelReport",
     "Pattern",
+    "PatternsError",
     "Piece",
     "PieceOptions",
-    "PatternsError",
     "Report",
     "Row",
     "Seam",

@@ -179,32 +179,15 @@ def _parse(argv) -> argparse.Namespace:
     return args
 
 
-def _records(args, name=None):
-    """The option records from parsed flags, each value checked as the API checks it: ``load``, ``flatten``
-    (flatten, check, batch), ``unfold`` (unfold, batch --unfold), ``check``, ``pieces``, ``write``, ``nest``."""
-    from .audit import CheckOptions
-    from .export import WriteOptions
-    from .flattening import FlattenOptions
-    from .nesting import NestOptions
-    from .options import from_arguments
-    from .pieces import PieceOptions
-    from .reading import LoadOptions
-    from .sheetmetal import UnfoldOptions
+def _bundle(args, name=None):
+    """The run's :class:`~patterns.bundle.Bundle` from parsed flags, each value checked as the API checks it:
+    kind ``load`` (info), ``unfold`` (unfold, batch --unfold) or ``flatten`` (flatten, check, batch)."""
+    from .bundle import Bundle
 
-    unfolding = args.command == "unfold" or (args.command == "batch" and args.unfold)
     if args.command == "info":
-        return {"load": from_arguments(LoadOptions, args, name=name)}
-    records = {}
-    if unfolding:
-        records["unfold"] = from_arguments(UnfoldOptions, args, name=name)  # the bend table read and checked
-    else:
-        records["load"] = from_arguments(LoadOptions, args, name=name)
-        records["flatten"] = from_arguments(FlattenOptions, args, name=name)
-    records["check"] = from_arguments(CheckOptions, args, name=name)
-    records["pieces"] = from_arguments(PieceOptions, args, name=name)
-    records["write"] = from_arguments(WriteOptions, args, name=name)
-    records["nest"] = from_arguments(NestOptions, args, name=name)
-    return records
+        return Bundle.from_arguments("load", args, name=name)
+    unfolding = args.command == "unfold" or (args.command == "batch" and args.unfold)
+    return Bundle.from_arguments("unfold" if unfolding else "flatten", args, name=name)
 
 
 # --------------------------------------------------------------------------- #
@@ -259,10 +242,10 @@ def _nested(nest) -> None:
         print(f"nested on {nest} (sparrow searched {nest.seconds:.1f} s)")
 
 
-def _wrote(result, records):
+def _wrote(result, bundle):
     for kind, path in result.outputs.items():
         if kind == "pattern" and path.suffix.lower() == ".dxf":
-            opts = records["write"]
+            opts = bundle.write
             print(f"wrote {path} ({opts.profile or 'machine'} profile, {opts.units}, layers {opts.layer_map})")
             if opts.units in ("cm", "m"):
                 print(f"note: {path} is in {opts.units}: Inkscape's DXF import and dxf2gcode read only mm and inches, "
@@ -270,7 +253,7 @@ def _wrote(result, records):
         elif kind == "pattern" and path.suffix.lower() == ".svg":
             print(f"wrote {path} (1:1 in mm: red cut, blue score, black engrave)")
         elif kind == "pattern":
-            print(f"wrote {path} (flat mesh, z = 0, in {records['write'].units})")
+            print(f"wrote {path} (flat mesh, z = 0, in {bundle.write.units})")
         elif kind == "preview" and result.part.preview_dpi is not None and path.suffix.lower() == ".png":
             dpi = result.part.preview_dpi
             print(f"wrote {path} (the DXF at 1:1 at {dpi:.3g} dpi"
@@ -293,19 +276,19 @@ class _Run:
 # --------------------------------------------------------------------------- #
 
 
-def _run_part(args, outputs: dict, records: dict):
+def _run_part(args, outputs: dict, bundle):
     """Plan the outputs, then flatten the part and write them all, or none."""
     from .files import Outputs
     from .jobs import flatten_part, inputs_of, plan_outputs
     from .reading import check_source
 
     check_source(args.input)
-    inputs = inputs_of(args.input, records)
-    planned = plan_outputs(outputs, inputs=inputs, profile=records["write"].profile)
+    inputs = inputs_of(args.input, bundle)
+    planned = plan_outputs(outputs, inputs=inputs, profile=bundle.write.profile)
     progress = Progress("flattening")
     with Outputs(inputs=inputs) as out:
         try:
-            part = flatten_part(args.input, records, outputs=planned, stage=out.stage, progress=progress,
+            part = flatten_part(args.input, bundle, outputs=planned, stage=out.stage, progress=progress,
                                 loaded=_loaded)
         finally:
             progress.close()
@@ -314,32 +297,32 @@ def _run_part(args, outputs: dict, records: dict):
 
 
 def _cmd_flatten(args) -> int:
-    records = _records(args, name=os.fsdecode(args.input))  # every option checked before any work
+    bundle = _bundle(args, name=os.fsdecode(args.input))  # every option checked before any work
     run = _run_part(args, {"pattern": args.output, "report": args.report, "heat_map": args.heat_map,
-                           "preview": args.preview}, records)
+                           "preview": args.preview}, bundle)
     part = run.part
-    print(f"flattened ({records['flatten'].method}) in {part.seconds['flatten']:.2f} s (the flattening alone)")
+    print(f"flattened ({bundle.flatten.method}) in {part.seconds['flatten']:.2f} s (the flattening alone)")
     _nested(part.nest)
     _print_panels(part.report)
-    _wrote(run, records)
+    _wrote(run, bundle)
     return _verdict(part.report)
 
 
 def _cmd_check(args) -> int:
-    records = _records(args, name=os.fsdecode(args.input))
-    run = _run_part(args, {"report": args.report, "heat_map": args.heat_map}, records)
+    bundle = _bundle(args, name=os.fsdecode(args.input))
+    run = _run_part(args, {"report": args.report, "heat_map": args.heat_map}, bundle)
     _print_panels(run.part.report)
-    _wrote(run, records)
+    _wrote(run, bundle)
     return _verdict(run.part.report)
 
 
 def _cmd_info(args) -> int:
     from .reading import check_source, load
 
-    records = _records(args, name=os.fsdecode(args.input))
+    bundle = _bundle(args, name=os.fsdecode(args.input))
     check_source(args.input)
     start = time.perf_counter()
-    model = load(args.input, records["load"])
+    model = load(args.input, bundle.load)
     _loaded(model, time.perf_counter() - start)
     rows = [("panel", "CAD faces", "vertices", "triangles", "outline loops", "area mm2")]
     for p in model.panels:
@@ -435,11 +418,11 @@ def _cmd_batch(args) -> int:
     from .batching import BatchOptions, batch, plan_batch
     from .options import from_arguments
 
-    records = _records(args)  # every option checked before any file is read
+    bundle = _bundle(args)  # every option checked before any file is read
     options = from_arguments(BatchOptions, args)
     files, _ = plan_batch(args.folder, args.output, unfold=options.unfold)
     progress = BatchProgress(len(files), quiet=options.quiet)
-    result = batch(files, args.output, records=records, options=options, on_row=progress.row,
+    result = batch(files, args.output, bundle=bundle, options=options, on_row=progress.row,
                    on_start=progress.start)
     progress.close()
     table = [("file", "panels", "seams", "strain RMS %", "max %", "seconds", "status")]
@@ -464,17 +447,17 @@ def _cmd_unfold(args) -> int:
     from .jobs import inputs_of, plan_outputs, unfold_part
     from .reading import CAD_SUFFIXES, check_source
 
-    records = _records(args, name=os.fsdecode(args.input))  # the bend table read and checked
+    bundle = _bundle(args, name=os.fsdecode(args.input))  # the bend table read and checked
     check_source(args.input, CAD_SUFFIXES)
-    inputs = inputs_of(args.input, records) + ([args.compare] if args.compare is not None else [])
+    inputs = inputs_of(args.input, bundle) + ([args.compare] if args.compare is not None else [])
     if args.compare is not None:
         check_input_file(args.compare, what="DXF file")
     planned = plan_outputs({"pattern": args.output, "report": args.report, "preview": args.preview,
                             "bend_sheet": args.bend_sheet}, inputs=inputs,
-                           suffixes={"pattern": (".dxf", ".svg")}, profile=records["write"].profile)
+                           suffixes={"pattern": (".dxf", ".svg")}, profile=bundle.write.profile)
     reference = read_flat_pattern(args.compare) if args.compare is not None else None
     with Outputs(inputs=inputs) as out:
-        part = unfold_part(args.input, records, outputs=planned, stage=out.stage, reference=reference)
+        part = unfold_part(args.input, bundle, outputs=planned, stage=out.stage, reference=reference)
         if part.subject.ok:
             out.commit()
     blank = part.subject
@@ -499,7 +482,7 @@ def _cmd_unfold(args) -> int:
         print(f"{', '.join(map(str, planned.values()))}: not written (the blank cannot be cut as it is)")
         return EXIT_CHECK
     _nested(part.nest)
-    _wrote(_Run(planned, part), records)
+    _wrote(_Run(planned, part), bundle)
     return EXIT_OK
 
 

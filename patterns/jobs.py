@@ -5,7 +5,7 @@ A run of ``patterns flatten`` or ``patterns unfold`` (or one file of
 and no run destroys a file it was not asked to write:
 
 1. **plan** -- before the input is read: every option checked by its
-   declaration (the records of :mod:`patterns.options`), the input checked
+   declaration (a :class:`patterns.bundle.Bundle` of the option records), the input checked
    (a readable regular file of a known type), every output checked
    (:func:`plan_outputs`: its kind's suffix, a writable folder, not a folder
    or a device, not an input -- the part, a bend table, a flat pattern to
@@ -33,9 +33,10 @@ import numpy as np
 
 from .audit import Report, check, checked_drawing
 from .blank import Blank
+from .bundle import Bundle
 from .comparison import BlankComparison, FlatPattern, compare_blank
 from .errors import InputError
-from .export import heat_map, preview_dxf, write, write_flat_obj
+from .export import WriteOptions, heat_map, preview_dxf, write, write_flat_obj
 from .export.registry import profile_for
 from .files import output_target
 from .flattening import flatten
@@ -65,11 +66,11 @@ _DXF = ("machine", "astm")
 """Profiles that only choose the DXF's dialect: with another output suffix they are not asked for."""
 
 
-def inputs_of(source, records: dict) -> list:
+def inputs_of(source, bundle: Bundle) -> list:
     """Every file a run reads: the part, and a bend table or a material table when one is given (no output may
     name them)."""
     out = [Path(source)]
-    unfolding = records.get("unfold")
+    unfolding = bundle.unfold
     if unfolding is not None and unfolding.bend_table is not None:
         out.append(Path(unfolding.bend_table.path))
     if unfolding is not None and unfolding.material_table is not None and unfolding.material_table.path:
@@ -122,7 +123,7 @@ def plan_outputs(outputs: dict, *, inputs=(), suffixes: dict | None = None, prof
     return planned
 
 
-def check_part(model: Model, records: dict, outputs: dict) -> None:
+def check_part(model: Model, bundle: Bundle, outputs: dict) -> None:
     """The checks that need the part but come before flattening it (InputError, in well under a second).
 
     A flat OBJ holds one panel; ``notch_spacing`` and ``bend_spacing`` must not
@@ -133,10 +134,10 @@ def check_part(model: Model, records: dict, outputs: dict) -> None:
     pattern_path = outputs.get("pattern")
     if pattern_path is not None and pattern_path.suffix.lower() == ".obj" and len(model.panels) != 1:
         raise InputError(f"{model.name}: {len(model.panels)} panels; a flat .obj holds one, write a .dxf")
-    if "pieces" in records:
+    if bundle.pieces is not None:
         check_marks(model.name, [s.length for s in model.seams],
-                    [float(np.ptp(p.vertices, axis=0).max()) for p in model.panels], records["pieces"])
-    nesting = records.get("nest")
+                    [float(np.ptp(p.vertices, axis=0).max()) for p in model.panels], bundle.pieces)
+    nesting = bundle.nest
     if nesting is not None and nesting.active:  # a panel a piece (gores and darts may add more, checked again)
         quantities = nesting.quantities or {}
         check_piece_count(model.name, [quantities.get(p.name, nesting.copies) for p in model.panels], nesting)
@@ -180,19 +181,18 @@ class PartResult:
 
 
 
-def _laid_out(subject, records: dict) -> tuple:
-    """``(drawing, nest or None)``: the subject's pieces, nested when the records give a roll or sheet."""
-    nesting = records.get("nest")
-    if nesting is not None and nesting.active:
-        nest = layout(subject, nesting, pieces=records["pieces"])
+def _laid_out(subject, bundle: Bundle) -> tuple:
+    """``(drawing, nest or None)``: the subject's pieces, nested when the bundle gives a roll or sheet."""
+    if bundle.nest.active:
+        nest = layout(subject, bundle.nest, pieces=bundle.pieces)
         return nest.drawing(), nest
-    return drawing_of(subject, records["pieces"]), None
+    return drawing_of(subject, bundle.pieces), None
 
 
-def _write(subject, drawing: Drawing, checked: Drawing, records: dict, outputs: dict, stage: Callable) -> tuple:
+def _write(subject, drawing: Drawing, checked: Drawing, options: WriteOptions, outputs: dict,
+           stage: Callable) -> tuple:
     """Every output, each to where ``stage`` says: ``({kind: staged path}, preview dpi)``."""
     written, dpi = {}, None
-    options = records["write"]
     for kind, path in outputs.items():
         tmp = stage(path, what=OUTPUT_KINDS[kind][1])
         if kind == "pattern" and path.suffix.lower() == ".obj":
@@ -214,7 +214,7 @@ def _write(subject, drawing: Drawing, checked: Drawing, records: dict, outputs: 
     return written, dpi
 
 
-def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, progress=None,
+def flatten_part(source, bundle: Bundle, *, outputs: dict, stage: Callable, progress=None,
                  loaded: Callable | None = None) -> PartResult:
     """Load, check the options against the part, flatten, make and nest the pieces, check, write every output.
 
@@ -222,10 +222,9 @@ def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, progr
     ----------
     source : str or Path
         The part's file.
-    records : dict
-        The option records: ``"load"`` (LoadOptions), ``"flatten"``, ``"check"``, ``"pieces"``
-        (PieceOptions), ``"write"`` (WriteOptions) and ``"nest"`` (NestOptions: the pieces nested on a
-        roll or sheets when it gives one).
+    bundle : patterns.bundle.Bundle
+        The run's options, a ``flatten`` bundle (its ``nest`` nests the pieces on a roll or sheets when it
+        gives one).
     outputs : dict
         ``{kind: Path}`` as :func:`plan_outputs` returns it.
     stage : callable
@@ -242,54 +241,53 @@ def flatten_part(source, records: dict, *, outputs: dict, stage: Callable, progr
     """
     seconds = {}
     start = time.perf_counter()
-    model = load(source, records["load"])
-    check_part(model, records, outputs)
+    model = load(source, bundle.load)
+    check_part(model, bundle, outputs)
     seconds["load"] = time.perf_counter() - start
     if loaded is not None:
         loaded(model, seconds["load"])
     start = time.perf_counter()
-    pattern = flatten(model, records["flatten"], progress=progress)
+    pattern = flatten(model, bundle.flatten, progress=progress)
     seconds["flatten"] = time.perf_counter() - start
     start = time.perf_counter()
-    drawing, nest = _laid_out(pattern, records)
+    drawing, nest = _laid_out(pattern, bundle)
     seconds["nest"] = time.perf_counter() - start
     start = time.perf_counter()
-    report, checked = checked_drawing(pattern, drawing, records["check"])
+    report, checked = checked_drawing(pattern, drawing, bundle.check)
     seconds["check"] = time.perf_counter() - start
     start = time.perf_counter()
-    written, dpi = _write(pattern, drawing, checked, records, outputs, stage)
+    written, dpi = _write(pattern, drawing, checked, bundle.write, outputs, stage)
     seconds["write"] = time.perf_counter() - start
     return PartResult(pattern, model, report, drawing, written, seconds, nest, dpi)
 
 
-def unfold_part(source, records: dict, *, outputs: dict, stage: Callable,
+def unfold_part(source, bundle: Bundle, *, outputs: dict, stage: Callable,
                 reference: FlatPattern | None = None) -> PartResult:
     """Unfold a bent sheet-metal part, make and nest its blank's pieces, check, write every output.
 
-    ``records`` as for :func:`flatten_part`, with ``"unfold"`` (UnfoldOptions) instead of ``"load"`` and
-    ``"flatten"``.  A blank that cannot be cut as it is (flanges that collide) writes nothing: its
+    ``bundle``: the run's options, an ``unfold`` :class:`~patterns.bundle.Bundle`.  A blank that cannot be cut as it is (flanges that collide) writes nothing: its
     result's report says why.  ``reference``: another CAD program's flat pattern of the part
     (:func:`patterns.read_flat_pattern`), compared in the result and the report.
     """
     seconds = {}
     start = time.perf_counter()
-    blank = unfold(source, records["unfold"])
+    blank = unfold(source, bundle.unfold)
     seconds["load"] = 0.0
     comparison = compare_blank(blank, reference) if reference is not None else None
     if not blank.ok:
         seconds["flatten"] = time.perf_counter() - start
-        return PartResult(blank, None, check(blank, records["check"]), drawing_of(blank, records["pieces"]),
+        return PartResult(blank, None, check(blank, bundle.check), drawing_of(blank, bundle.pieces),
                           seconds=seconds, comparison=comparison)
     seconds["flatten"] = time.perf_counter() - start
     start = time.perf_counter()
-    drawing, nest = _laid_out(blank, records)
+    drawing, nest = _laid_out(blank, bundle)
     seconds["nest"] = time.perf_counter() - start
     start = time.perf_counter()
-    report, checked = checked_drawing(blank, drawing, records["check"])
+    report, checked = checked_drawing(blank, drawing, bundle.check)
     if comparison is not None:
         checked = replace(checked, report={**checked.report, "comparison": comparison.to_dict(reference.path)})
     seconds["check"] = time.perf_counter() - start
     start = time.perf_counter()
-    written, dpi = _write(blank, drawing, checked, records, outputs, stage)
+    written, dpi = _write(blank, drawing, checked, bundle.write, outputs, stage)
     seconds["write"] = time.perf_counter() - start
     return PartResult(blank, None, report, drawing, written, seconds, nest, dpi, comparison)

@@ -94,9 +94,12 @@ def _sheet(value, option_name):
 def _parse_sheet(text: str):
     """``"2500x1250"`` (command line) as ``(2500.0, 1250.0)``."""
     parts = text.lower().replace("*", "x").split("x")
-    if len(parts) != 2:
-        raise ValueError(f"expected LENGTHxWIDTH in mm, e.g. 2500x1250, got {text!r}")
-    return tuple(float(p) for p in parts)
+    try:
+        if len(parts) == 2:
+            return tuple(float(p) for p in parts)
+    except ValueError:
+        pass
+    raise ValueError(f"expected LENGTHxWIDTH in mm, e.g. 2500x1250, got {text!r}")
 
 
 def _quantities(value, option_name):

@@ -15,6 +15,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import difflib
 import math
@@ -30,10 +31,21 @@ from .errors import InputError
 from .units import LARGEST_LENGTH
 
 __all__ = ["Options", "Spec", "add_arguments", "check_number", "check_ratio", "cli_flags", "from_arguments", "from_text",
-           "is_number", "label", "option", "suggest"]
+           "is_number", "label", "naming", "option", "parse_text", "suggest"]
 
 _LABELS: contextvars.ContextVar = contextvars.ContextVar("patterns_option_labels", default=None)
 """``{option name: what to call it}`` while a record is made from the command line's flags (the flags)."""
+
+
+@contextlib.contextmanager
+def naming(names: dict):
+    """Within it, the records' messages call each option as ``names`` says (``{field name: name}``): the
+    command line's flags, or a bundle's names (``dart_strain`` for ``FlattenOptions.max_strain``)."""
+    token = _LABELS.set(names)
+    try:
+        yield
+    finally:
+        _LABELS.reset(token)
 
 
 def label(name: str) -> str:
@@ -165,6 +177,10 @@ class Spec:
     off : str, optional
         For an option that is on by default: the help of the command line's
         ``--no-...`` flag, saying what the flag does (required there).
+    text : callable, optional
+        A checked value (one item, for ``repeat``) back to the text ``parse``
+        reads (a table's path, an ease's ``SEAM:PANEL:MM``): the JSON form of
+        a value JSON has no type for (:meth:`patterns.bundle.Bundle.to_json`).
     """
 
     help: str
@@ -182,6 +198,7 @@ class Spec:
     metavar: str | None = None
     unit: str | None = None
     off: str | None = None
+    text: Callable | None = None
 
     def __post_init__(self):
         if self.unit == "mm":
@@ -407,11 +424,8 @@ def from_arguments(record: type, args, *, name: str | None = None, **extra):
             if not (spec.repeat and value is None):
                 values[f.name] = value
     values.update(extra)
-    token = _LABELS.set(cli_flags(record))  # the messages name the flags the user typed
-    try:
+    with naming(cli_flags(record)):  # the messages name the flags the user typed
         return record.of(None, values, name=name)
-    finally:
-        _LABELS.reset(token)
 
 
 def cli_flags(record: type) -> dict:
@@ -425,8 +439,9 @@ def cli_flags(record: type) -> dict:
     return out
 
 
-def _parse_text(spec: Spec, default, text: str):
-    """One value from its text, as the command line parses it (before the record checks it)."""
+def parse_text(spec: Spec, default, text: str):
+    """One value from its text, as the command line parses it (before the record checks it); ValueError if
+    it cannot be read."""
     if spec.parse is not None:
         return spec.parse(text)
     if spec.integer:
@@ -451,12 +466,12 @@ def from_text(record: type, texts: dict, *, name: str | None = None, separator: 
             continue
         try:
             if spec.repeat:
-                values[f.name] = [_parse_text(spec, f.default, item.strip()) for item in str(text).split(separator)
+                values[f.name] = [parse_text(spec, f.default, item.strip()) for item in str(text).split(separator)
                                   if item.strip()]
             elif isinstance(f.default, bool):
                 values[f.name] = str(text).strip().lower() in ("1", "true", "yes", "on")
             else:
-                values[f.name] = _parse_text(spec, f.default, str(text).strip())
+                values[f.name] = parse_text(spec, f.default, str(text).strip())
         except ValueError as exc:
             prefix = f"{name}: " if name else ""
             raise InputError(f"{prefix}{f.name}: {exc}") from None

@@ -19,7 +19,7 @@ import pytest
 import patterns
 from patterns.cli import main
 from patterns.hosts import freecad as host
-from patterns.service import brep, records_of, schema
+from patterns.service import brep, schema
 from patterns.service.work import key_of
 
 ADDON = Path(host.ADDON) / "freecad" / "patterns_wb"
@@ -95,15 +95,16 @@ def test_a_shape_is_flattened_as_the_api_flattens_it(worker, tmp_path):
 def test_the_two_strain_limits_are_two_options():
     """``dart_strain`` drives the darts, ``max_strain`` the check, as on the command line (they were one
     property in FreeCAD); the nester's ``gap`` is ``nest_gap`` beside the pieces' ``gap``."""
-    from patterns import CheckOptions, FlattenOptions, NestOptions, PieceOptions
+    from patterns import Bundle
 
     names = {(p["record"], p["option"]): p["name"] for p in schema()["pattern"]}
     assert names[("FlattenOptions", "max_strain")] == "dart_strain"
     assert names[("CheckOptions", "max_strain")] == "max_strain"
     assert names[("NestOptions", "gap")] == "nest_gap" and names[("PieceOptions", "gap")] == "gap"
-    records = records_of("pattern", {"dart_strain": 0.03, "max_strain": 0.05, "gap": 4.0, "nest_gap": 7.0}, name="x")
-    assert records[FlattenOptions].max_strain == 0.03 and records[CheckOptions].max_strain == 0.05
-    assert records[PieceOptions].gap == 4.0 and records[NestOptions].gap == 7.0
+    bundle = Bundle.from_json("pattern", {"dart_strain": 0.03, "max_strain": 0.05, "gap": 4.0, "nest_gap": 7.0},
+                              name="x")
+    assert bundle.flatten.max_strain == 0.03 and bundle.check.max_strain == 0.05
+    assert bundle.pieces.gap == 4.0 and bundle.nest.gap == 7.0
     assert len({p["name"] for p in schema()["blank"]}) == len(schema()["blank"])
 
 
@@ -114,7 +115,7 @@ def test_bad_requests_get_one_error_each_and_the_worker_lives_on(worker):
     assert unknown["id"] == 7 and "unknown operation 'fly'" in unknown["error"]["message"]
     option = worker.ask({"id": 8, "op": "validate", "kind": "pattern", "name": "Cut", "options": {"seam_allowance": -3}})
     assert option["error"] == {"type": "InputError",
-                               "message": "Cut: seam_allowance (mm) must be a number between 0 and 1000, got -3.0"}
+                               "message": "Cut: seam_allowance (mm) must be a number between 0 and 1000, got -3"}
     shape = worker.ask({"id": 9, "op": "make", "kind": "pattern", "name": "Cut", "shape": "not brep", "options": {}})
     assert shape["error"]["type"] == "CadError" and "Cut" in shape["error"]["message"]
     kind = worker.ask({"id": 10, "op": "validate", "kind": "sail", "name": "Cut", "options": {}})

@@ -24,15 +24,11 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
-from ..audit import CheckOptions
+import warnings
+
+from ..bundle import Bundle
 from ..errors import InputError, PatternsError, Terminated
-from ..export import WriteOptions
 from ..files import Outputs
-from ..flattening import FlattenOptions
-from ..nesting import NestOptions
-from ..pieces import PieceOptions
-from ..reading import LoadOptions
-from ..sheetmetal import UnfoldOptions
 from ..text import printable
 from .cluster import DaskRunner
 from .local import LocalRunner
@@ -52,16 +48,14 @@ from .worker import process_part
 __all__ = ["STATUSES", "BatchOptions", "BatchResult", "Row", "batch", "check_output_folder", "output_stems",
            "plan_batch", "process_part"]
 
-_FLATTEN = {"load": LoadOptions, "flatten": FlattenOptions, "check": CheckOptions, "pieces": PieceOptions,
-            "write": WriteOptions, "nest": NestOptions}
-"""The records of a part that is flattened."""
-_UNFOLD = {"unfold": UnfoldOptions, "check": CheckOptions, "pieces": PieceOptions, "write": WriteOptions,
-           "nest": NestOptions}
-"""The records of a part that is unfolded."""
+_TWO_WAYS = {"max_strain": "dart_strain", "gap": "nest_gap"}
+"""Keywords that 0.2.0's ``batch`` gave to two records (``max_strain`` the darts' and the check's limit, ``gap`` the
+pieces' and the nester's): they still do, with a warning, until 0.3.0 (then the check's and the pieces' only)."""
 
 
-def batch(files, out, *, records: dict | None = None, options: BatchOptions | None = None,
-          on_row: Callable | None = None, on_start: Callable | None = None, **keywords) -> BatchResult:
+def batch(files, out, *, bundle: Bundle | None = None, options: BatchOptions | None = None,
+          on_row: Callable | None = None, on_start: Callable | None = None, records: dict | None = None,
+          **keywords) -> BatchResult:
     """Flatten many parts in parallel into one folder: every file ends as a :class:`Row`.
 
     Parameters
@@ -75,9 +69,9 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
         name where two stems collide (``a.step.dxf``, ``a.stl.dxf``), compared
         ignoring case; whole names that still collide are numbered
         (``part.step-2.dxf``): see :func:`output_stems`.
-    records : dict, optional
-        The part's option records (``"load"``, ``"flatten"``, ``"check"``,
-        ``"dxf"``, ``"nest"``), as the command line makes them; default from
+    bundle : patterns.bundle.Bundle, optional
+        The part's options, a ``flatten`` bundle (``unfold`` with
+        ``unfold=True``), as the command line makes it; default from
         ``keywords``.
     options : BatchOptions, optional
         How the batch runs; keywords (``jobs``, ``scheduler``, ``timeout``,
@@ -86,11 +80,14 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
         ``on_row(row, done, total)`` as each file ends (progress).
     on_start : callable, optional
         ``on_start(name)`` as each file is handed to a worker.
+    records : dict, optional
+        Deprecated (goes in 0.3.0): ``{"load": LoadOptions, ...}``; give ``bundle``.
     **keywords
-        Any option of ``flatten``: :class:`~patterns.LoadOptions`,
-        :class:`~patterns.FlattenOptions`, :class:`~patterns.CheckOptions`,
-        :class:`~patterns.DxfOptions`, :class:`~patterns.NestOptions` (each
-        part nested on its own roll or sheets) fields, and :class:`BatchOptions` fields.
+        Any option of the bundle, by its name (:meth:`patterns.bundle.Bundle.names`: the fields of
+        :class:`~patterns.LoadOptions`, :class:`~patterns.FlattenOptions`, :class:`~patterns.CheckOptions`,
+        :class:`~patterns.PieceOptions`, :class:`~patterns.WriteOptions`, :class:`~patterns.NestOptions`,
+        each part nested on its own roll or sheets; ``dart_strain`` is the darts' limit, ``max_strain``
+        the check's, ``nest_gap`` the nester's gap), and :class:`BatchOptions` fields.
 
     Returns
     -------
@@ -108,7 +105,7 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
     the local workers are fresh interpreters that run only this package
     (:mod:`patterns.batching.local`) and never import the caller's ``__main__``.
     """
-    opts, records = _options(options, records, keywords)
+    opts, bundle = _options(options, bundle, records, keywords)
     if isinstance(files, (str, os.PathLike)) and Path(files).is_dir():
         files, stems = plan_batch(files, out, unfold=opts.unfold)
     else:
@@ -127,7 +124,7 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
     rows = {}
     stopped = ""
     try:
-        for index, row in runner.run(files, records, kinds, on_start):
+        for index, row in runner.run(files, bundle, kinds, on_start):
             path = files[index]
             row = _commit(out, stems[path], row)
             rows[index] = row
@@ -145,24 +142,31 @@ def batch(files, out, *, records: dict | None = None, options: BatchOptions | No
     return BatchResult(tuple(rows[i] for i in range(len(files))), runner.where, stopped)
 
 
-def _options(options, records, keywords):
+def _options(options, bundle, records, keywords) -> tuple:
+    """``(BatchOptions, Bundle)`` from what :func:`batch` was given, every value checked."""
     mine = {k: v for k, v in keywords.items() if k in BatchOptions.__dataclass_fields__}
     rest = {k: v for k, v in keywords.items() if k not in mine}
     opts = BatchOptions.of(options, mine)
-    if records is None:
-        kinds = dict(_UNFOLD if opts.unfold else _FLATTEN)
-        records = {}
-        for key, record in kinds.items():
-            fields = record.__dataclass_fields__
-            records[key] = record.of(None, {k: v for k, v in rest.items() if k in fields})
-        unknown = sorted(set(rest) - {f for r in kinds.values() for f in r.__dataclass_fields__})
-        if unknown:
-            raise InputError(f"unknown option {unknown[0]!r} for batch{' --unfold' if opts.unfold else ''}")
+    kind = "unfold" if opts.unfold else "flatten"
+    if records is not None:
+        warnings.warn("batch(records=) goes in 0.3.0: give bundle=patterns.bundle.Bundle(...)", DeprecationWarning,
+                      stacklevel=3)
+        bundle = Bundle(kind, **records)
+    if bundle is None:
+        names = {n.name for n in Bundle.names(kind)}
+        for old, new in _TWO_WAYS.items():
+            if old in rest and new not in rest and new in names:
+                warnings.warn(f"batch({old}=) sets {old} and {new} (as 0.2.0 did) until 0.3.0, then {old} only: "
+                              f"give {new}= as well", DeprecationWarning, stacklevel=3)
+                rest[new] = rest[old]
+        bundle = Bundle.of(kind, rest, name=f"batch{' (unfold)' if opts.unfold else ''}")
     elif rest:
-        raise InputError(f"give the part's options as records or as keywords, not both ({min(rest)!r})")
+        raise InputError(f"give the part's options as a bundle or as keywords, not both ({min(rest)!r})")
+    if not isinstance(bundle, Bundle) or bundle.kind != kind:
+        raise InputError(f"bundle must be a patterns {kind} Bundle, got {bundle!r}")
     if opts.unfold and opts.heat_map:
         raise InputError("a blank is exact: it has no strain heat map (leave out heat_map with unfold)")
-    return opts, records
+    return opts, bundle
 
 
 def _commit(out: Path, stem: str, row: dict) -> Row:

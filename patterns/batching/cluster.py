@@ -89,7 +89,7 @@ class DaskRunner:
             self.close()
             raise InputError(f"{self.opts.scheduler}: " + "; ".join(problems))
 
-    def run(self, files, records, wanted, on_start):
+    def run(self, files, bundle, wanted, on_start):
         from distributed import wait
 
         pending = {}  # future -> (index, tries)
@@ -99,7 +99,7 @@ class DaskRunner:
             path = files[index]
             data = path.read_bytes()
             payload = self.client.scatter(data, hash=False) if len(data) > 1 << 20 else data
-            future = self.client.submit(process_part, path.name, payload, records, wanted, pure=False)
+            future = self.client.submit(process_part, path.name, payload, bundle, wanted, pure=False)
             pending[future] = (index, tries)
             if on_start is not None and tries == 1:
                 on_start(printable(path.name))

@@ -147,7 +147,7 @@ class LocalRunner:
         advice = "; with --memory, give them more" if said[2] else ""
         raise PatternsError(f"the worker processes cannot start ({printable(said[1])}){advice}")
 
-    def run(self, files, records, wanted, on_start):
+    def run(self, files, bundle, wanted, on_start):
         from multiprocessing.connection import wait
 
         pending = deque((i, 1) for i in largest_first(files))
@@ -170,7 +170,7 @@ class LocalRunner:
                     on_start(printable(path.name))
                 worker.task, worker.started = (index, tries), time.monotonic()
                 try:
-                    worker.conn.send((path.name, data, records, wanted))
+                    worker.conn.send((path.name, data, bundle, wanted))
                 except OSError:  # it died as the file was handed over: the answer's wait below sees it
                     pass
             busy = [w for w in self.workers if w.task is not None]

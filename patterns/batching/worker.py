@@ -23,6 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from ..bundle import Bundle
 from ..errors import PatternsError
 from ..findings import Code
 from ..jobs import PartResult, flatten_part, unfold_part
@@ -31,7 +32,7 @@ from .plan import _SUFFIXES
 __all__ = ["OUT_OF_MEMORY", "Channel", "process_part", "spawn_main", "worker_main"]
 
 
-def process_part(name: str, data: bytes, records: dict, wanted: tuple) -> dict:
+def process_part(name: str, data: bytes, bundle: Bundle, wanted: tuple) -> dict:
     """Run the pipeline on one part given as bytes; return its row and outputs as bytes.  Never raises
     for the part's fault (a bad file, a limit, memory): that becomes the row's reason.
 
@@ -41,9 +42,8 @@ def process_part(name: str, data: bytes, records: dict, wanted: tuple) -> dict:
         The input's file name (its suffix says its type).
     data : bytes
         The file's content.
-    records : dict
-        The option records (``"load"``, ``"flatten"``, ``"check"``, ``"pieces"``, ``"write"``, ``"nest"``;
-        ``"unfold"`` instead of ``"load"`` and ``"flatten"`` to unfold a bent sheet-metal part).
+    bundle : patterns.bundle.Bundle
+        The part's options: a ``flatten`` bundle, or an ``unfold`` one to unfold a bent sheet-metal part.
     wanted : tuple of str
         Output kinds: ``"pattern"`` (DXF), ``"report"``, ``"heat_map"``, ``"preview"``.
 
@@ -60,9 +60,9 @@ def process_part(name: str, data: bytes, records: dict, wanted: tuple) -> dict:
             source = Path(tmp) / name
             source.write_bytes(data)
             outputs = {kind: Path(tmp) / _SUFFIXES[kind].format("out") for kind in wanted}
-            run = unfold_part if "unfold" in records else flatten_part
+            run = unfold_part if bundle.kind == "unfold" else flatten_part
             try:
-                part = run(source, records, outputs=outputs, stage=lambda path, what: path)
+                part = run(source, bundle, outputs=outputs, stage=lambda path, what: path)
             except PatternsError as exc:
                 row["reason"] = str(exc).replace(tmp + os.sep, "")
                 return row

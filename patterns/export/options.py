@@ -43,7 +43,7 @@ class WriteOptions(Options):
     layer_map: LayerMap = option(layer_map("patterns"), "machine profile: the layers, a preset (" + ", ".join(PRESETS)
                                  + ") then role=LAYER overrides, e.g. updown or 'solidworks,label=TEXT' "
                                    "(role= leaves a role out); see docs/dxf.md", check=layer_map, parse=str,
-                                 metavar="MAP")
+                                 metavar="MAP", text=str)
     bend_lines: bool = option(True, "draw bend and ruling lines (--no-bend-lines leaves them and their labels out, "
                                     "for a cutter that would cut them)", flag="--no-bend-lines",
                                     off="leave bend and ruling lines and their labels out (for a cutter that would "

@@ -48,6 +48,15 @@ def parse_ease(text: str) -> Ease:
         raise ValueError(f"expected SEAM:PANEL:MM or SEAM:PANEL:PERCENT%, got {text!r}") from None
 
 
+def ease_text(ease: Ease) -> str:
+    """An :class:`Ease` as the command line writes it (the inverse of :func:`parse_ease`); ValueError for one
+    with both ``mm`` and ``ratio``, which that text cannot say."""
+    if ease.mm and ease.ratio:
+        raise ValueError(f"seam {ease.seam} of {ease.panel}: an ease of both mm and ratio has no text form")
+    amount = f"{ease.ratio * 100!r}%" if ease.ratio else repr(float(ease.mm))
+    return f"{ease.seam}:{ease.panel}:{amount}"
+
+
 def _grain(value, option):
     """A 3D direction, or a mapping of panel names to 3D directions (names checked against the model later)."""
     if isinstance(value, Mapping):
@@ -101,7 +110,7 @@ class FlattenOptions(Options):
                                 "length (total), or nothing (free)", choices=tuple(m.value for m in SeamLengths))
     ease: tuple | None = option(None, "deliberate extra length on one side of a seam (patterns.Ease; on the command "
                                 "line SEAM:PANEL:MM or SEAM:PANEL:PERCENT%, repeatable)",
-                          check=_ease, parse=parse_ease, repeat=True, metavar="SEAM:PANEL:AMOUNT")
+                          check=_ease, parse=parse_ease, repeat=True, metavar="SEAM:PANEL:AMOUNT", text=ease_text)
     max_strain: float | None = option(None, "cut darts into a freeform panel whose worst triangle strain is "
                                             "above this ratio (0.03 = 3 %): the fewest evenly spaced darts, as short "
                                             "as the limit allows",

@@ -6,12 +6,12 @@ Blender next) starts it once, keeps it warm between recomputes, restarts it if i
 the host exits.  Nothing of the engine's environment enters the host's process: shapes cross as BREP
 text, results as BREP text and plain numbers.
 
-:mod:`~patterns.service.schema` gives the hosts the options (one property per option of the records,
-checked by the records), :mod:`~patterns.service.work` computes, :mod:`~patterns.service.brep` turns
+:mod:`~patterns.service.schema` gives the hosts the options (one property per option of a
+:class:`~patterns.bundle.Bundle`, checked by its records), :mod:`~patterns.service.work` computes, :mod:`~patterns.service.brep` turns
 shapes into text and back; :mod:`patterns.hosts` puts a host's side into the host.
 """
 
-from .schema import KINDS, records_of, schema
+from .schema import properties, records_of, schema
 from .server import PROTOCOL, Server, serve
 
-__all__ = ["KINDS", "PROTOCOL", "Server", "records_of", "schema", "serve"]
+__all__ = ["PROTOCOL", "Server", "properties", "records_of", "schema", "serve"]

@@ -1,32 +1,22 @@
-"""The options of a host's objects: one property per option of the records, declared once, checked once.
+"""The options of a host's objects: one property per option of the kind's :class:`~patterns.bundle.Bundle`.
 
 A host (FreeCAD, Blender) shows the options of a pattern or a blank as properties of its own objects and
-sends their values back as they are; the worker makes the option records from them with
-:func:`patterns.options.from_text` -- the records' own validator, the one the API and the command line use.
+sends their values back as they are; the worker makes the bundle from them (:meth:`Bundle.from_json
+<patterns.bundle.Bundle.from_json>`) -- the records' own validator, the one the API and the command line use.
 The schema a host builds its properties from (:func:`schema`) is sent by the worker (``hello``), so the host
-side declares no option of its own.
-
-Naming: a property is named as its option, except where two records of one object share a name; then a
-record whose option has its own command-line flag takes the flag's name (``FlattenOptions.max_strain`` is
-``dart_strain`` beside ``CheckOptions.max_strain``, the nester's ``gap`` is ``nest_gap`` beside the pieces'
-``gap``), as on the command line.
+side declares no option of its own, and a property is named as the bundle names its option (``dart_strain``
+for the darts' limit beside the check's ``max_strain``, ``nest_gap`` beside the pieces' ``gap``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
-from ..audit import CheckOptions
+from ..bundle import HOST_KINDS, KINDS, Bundle, Name
 from ..errors import InputError
-from ..flattening import FlattenOptions
-from ..nesting import NestOptions
-from ..options import flag_of, from_text, is_number
-from ..pieces import PieceOptions
-from ..pieces.options import PATTERN_ONLY
-from ..sheetmetal import UnfoldOptions
-from ..tessellate import MeshingOptions
+from ..options import is_number
 
-__all__ = ["KINDS", "Kind", "Property", "records_of", "schema"]
+__all__ = ["Property", "properties", "records_of", "schema"]
 
 
 @dataclass(frozen=True)
@@ -71,14 +61,15 @@ class Property:
                 "low": self.low, "high": self.high}
 
 
-def _kind(f, spec) -> str:
-    if isinstance(f.default, bool):
+def _kind(entry: Name) -> str:
+    spec, default = entry.spec, entry.default
+    if isinstance(default, bool):
         return "bool"
     if spec.choices is not None:
         return "choice"
-    if f.default is not None and spec.integer:
+    if default is not None and spec.integer:
         return "int"
-    if f.default is not None and not spec.repeat and is_number(f.default) and (spec.check is None or spec.parse is float):
+    if default is not None and not spec.repeat and is_number(default) and (spec.check is None or spec.parse is float):
         return "float"
     return "text"
 
@@ -91,78 +82,33 @@ def _default(kind: str, default):
     return default
 
 
-@dataclass(frozen=True)
-class Kind:
-    """An object kind of the hosts (``pattern``, ``blank``): its records, their groups, the options it has not."""
-
-    name: str
-    records: tuple
-    groups: tuple
-    skip: frozenset = frozenset()
-
-    def properties(self) -> tuple:
-        """Every option as a :class:`Property`, record by record."""
-        options = [(record, group, f) for record, group in zip(self.records, self.groups) for f in fields(record)
-                   if "spec" in f.metadata and (record, f.name) not in self.skip]
-        shared = {f.name for _, _, f in options if sum(g.name == f.name for _, _, g in options) > 1}
-        out, taken = [], set()
-        for record, group, f in options:
-            spec = f.metadata["spec"]
-            name = f.name
-            if name in shared and spec.flag and not spec.flag.startswith("--no-"):
-                name = flag_of(f.name, spec).lstrip("-").replace("-", "_")
-            if name in taken:
-                raise TypeError(f"{self.name}: two options are both named {name!r}: give one a flag of its own")
-            taken.add(name)
-            kind = _kind(f, spec)
-            out.append(Property(name, record.__name__, f.name, group, kind, _default(kind, f.default), spec.help,
-                                tuple(spec.choices or ()), spec.low, spec.high))
-        return tuple(out)
-
-
-KINDS = {
-    "pattern": Kind("pattern", (MeshingOptions, FlattenOptions, PieceOptions, NestOptions, CheckOptions),
-                    ("Meshing", "Flattening", "Pieces", "Nesting", "Check")),
-    "blank": Kind("blank", (UnfoldOptions, PieceOptions, NestOptions, CheckOptions),
-                  ("Unfolding", "Pieces", "Nesting", "Check"), frozenset((PieceOptions, n) for n in PATTERN_ONLY)),
-}
-"""The kinds of object a host makes, by name."""
+def properties(kind: str) -> tuple:
+    """Every option of a host's ``kind`` (``pattern``, ``blank``) as a :class:`Property`, record by record."""
+    if kind not in HOST_KINDS:
+        raise InputError(f"unknown kind {kind!r}; the kinds are {', '.join(HOST_KINDS)}")
+    slots = {slot.name: slot for slot in KINDS[kind].slots}
+    out = []
+    for entry in Bundle.names(kind):
+        slot, option = entry.targets[0]
+        kind_of = _kind(entry)
+        spec = entry.spec
+        out.append(Property(entry.name, slots[slot].record.__name__, option, entry.group, kind_of,
+                            _default(kind_of, entry.default), spec.help, tuple(spec.choices or ()), spec.low,
+                            spec.high))
+    return tuple(out)
 
 
 def schema() -> dict:
     """``{kind: [property as a dict, ...]}``: what a host builds its objects' properties from."""
-    return {name: [p.to_dict() for p in kind.properties()] for name, kind in KINDS.items()}
-
-
-def _text(value) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
-        return repr(value)
-    return "" if value is None else str(value)
+    return {kind: [p.to_dict() for p in properties(kind)] for kind in HOST_KINDS}
 
 
 def records_of(kind: str, values: dict, *, name: str) -> dict:
-    """``{record class: record}`` of one object from its properties' ``values`` (``{property name: value}``,
-    those left out at their defaults), each checked by its record.
+    """Deprecated (goes in 0.3.0): ``{record class: record}`` of a host's object; use
+    :meth:`patterns.bundle.Bundle.from_json` and :meth:`~patterns.bundle.Bundle.records`."""
+    import warnings
 
-    Raises
-    ------
-    InputError
-        An unknown kind or property (naming the known ones), or a bad value (the record's own message,
-        after ``name``).
-    """
-    if kind not in KINDS:
-        raise InputError(f"{name}: unknown kind {kind!r}; the kinds are {', '.join(KINDS)}")
-    if not isinstance(values, dict):
-        raise InputError(f"{name}: the options must be an object of property names and values")
-    properties = KINDS[kind].properties()
-    known = {p.name for p in properties}
-    unknown = sorted(set(values) - known)
-    if unknown:
-        raise InputError(f"{name}: unknown option {unknown[0]!r}; the options are {', '.join(sorted(known))}")
-    texts: dict = {}
-    for p in properties:
-        if p.name in values:
-            texts.setdefault(p.record, {})[p.option] = _text(values[p.name])
-    return {record: from_text(record, texts.get(record.__name__, {}), name=name) for record in KINDS[kind].records}
+    warnings.warn("patterns.service.records_of goes in 0.3.0: use patterns.bundle.Bundle.from_json(kind, values)",
+                  DeprecationWarning, stacklevel=2)
+    bundle = Bundle.from_json(kind, values, name=name)
+    return {type(record): record for record in bundle.records().values()}

@@ -18,22 +18,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..audit import CheckOptions, Report, checked_drawing
+from ..audit import Report, checked_drawing
 from ..blank import Blank
+from ..bundle import HOST_KINDS, Bundle
 from ..errors import InputError
 from ..export import WriteOptions, write
 from ..export.layers import PRESETS
-from ..flattening import FlattenOptions, flatten
-from ..nesting import NestOptions, layout
+from ..flattening import flatten
+from ..nesting import layout
 from ..pattern import Pattern
-from ..pieces import Drawing, PieceOptions, drawing_of, piece_labels
+from ..pieces import Drawing, drawing_of, piece_labels
 from ..reading import mesh_model
-from ..sheetmetal import UnfoldOptions, unfold
-from ..tessellate import MeshingOptions, mesh_shape
+from ..sheetmetal import unfold
+from ..tessellate import mesh_shape
 from . import brep
-from .schema import records_of
 
-__all__ = ["Made", "Results", "export", "figures", "key_of", "make", "validate"]
+__all__ = ["Made", "Results", "bundle_of", "export", "figures", "key_of", "make", "validate"]
 
 
 _FLAGS = re.compile(r"(?m)^[01]{7}$")
@@ -87,25 +87,33 @@ class Results:
         return made
 
 
+def bundle_of(kind: str, options: dict, *, name: str) -> Bundle:
+    """The bundle of a host's object (kind ``pattern`` or ``blank``) from its request's options, each checked by
+    its record (InputError naming ``name``)."""
+    if kind not in HOST_KINDS:
+        raise InputError(f"{name}: unknown kind {kind!r}; the kinds are {', '.join(HOST_KINDS)}")
+    return Bundle.from_json(kind, options, name=name)
+
+
 def _compute(kind: str, shape: str, options: dict, name: str, key: str = "") -> Made:
-    records = records_of(kind, options, name=name)  # every option checked before the shape is read
+    bundle = bundle_of(kind, options, name=name)  # every option checked before the shape is read
     if shape.startswith("{"):  # a mesh (its arrays as JSON: see _fields), never BREP text
         if kind != "pattern":
             raise InputError(f"{name}: a blank is unfolded from a CAD shape (BREP), not a mesh")
         mesh = json.loads(shape)
         model = mesh_model(np.asarray(mesh["vertices"], dtype=np.float64), np.asarray(mesh["faces"]), name=name)
-        subject = flatten(model, records[FlattenOptions])
+        subject = flatten(model, bundle.flatten)
     elif kind == "pattern":
-        model = mesh_shape(brep.from_brep(shape, name), records[MeshingOptions], name=name)
-        subject = flatten(model, records[FlattenOptions])
+        model = mesh_shape(brep.from_brep(shape, name), bundle.load, name=name)
+        subject = flatten(model, bundle.flatten)
     else:
-        subject = unfold(brep.from_brep(shape, name), records[UnfoldOptions], name=name)
-    nesting = records[NestOptions]
+        subject = unfold(brep.from_brep(shape, name), bundle.unfold, name=name)
+    nesting = bundle.nest
     if nesting.active:
-        drawing = layout(subject, nesting, pieces=records[PieceOptions]).drawing()
+        drawing = layout(subject, nesting, pieces=bundle.pieces).drawing()
     else:
-        drawing = drawing_of(subject, records[PieceOptions])
-    report, checked = checked_drawing(subject, drawing, records[CheckOptions])
+        drawing = drawing_of(subject, bundle.pieces)
+    report, checked = checked_drawing(subject, drawing, bundle.check)
     return Made(key, subject, drawing, checked, report)
 
 
@@ -172,7 +180,7 @@ def make(results: Results, request: dict) -> dict:
 def validate(request: dict) -> dict:
     """The reply to ``validate``: the options checked by their records, nothing computed (InputError if bad)."""
     name = request.get("name") or "shape"
-    records_of(request.get("kind"), request.get("options") or {}, name=str(name))
+    bundle_of(request.get("kind"), request.get("options") or {}, name=str(name))
     return {}
 
 

@@ -169,7 +169,8 @@ class UnfoldOptions(Options):
                                   "the thickness (SolidWorks' and FreeCAD's K-factor)", low=0, high=1)
     bend_table: BendTable | None = option(None, "bend-deduction table, CSV with columns thickness, radius, angle, "
                                       "deduction (mm, degrees); it gives every bend instead of the K-factor",
-                                optional=True, check=_table, metavar="CSV")
+                                optional=True, check=_table, metavar="CSV",
+                                text=lambda table: table.path)
     fixed_face: int | None = option(None, "the CAD face that keeps its place (shape.faces() index, or FreeCAD's "
                                           "name FaceN for index N-1; default the largest planar face that starts a "
                                           "sheet)", integer=True, low=0, optional=True, metavar="N",
@@ -187,7 +188,8 @@ class UnfoldOptions(Options):
     material_table: MaterialTable | None = option(None, "your own material table for material, CSV with columns "  # noqa: RUF009
                                                         "material, thickness_min, thickness_max, rt_min, rt_max, "
                                                         "k_factor (default: the bundled table)",
-                                                  optional=True, check=_path_or_table, metavar="CSV")
+                                                  optional=True, check=_path_or_table, metavar="CSV",
+                                                  text=lambda table: table.path)
 
     def __post_init__(self):
         super().__post_init__()
