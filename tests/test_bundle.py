@@ -47,7 +47,7 @@ def test_the_command_line_batch_and_the_worker_make_the_same_bundle():
     cli = _cli(["flatten", "part.step", "-o", "out.dxf", "--dart-strain", "0.03", "--max-strain", "0.05",
                 "--gap", "4", "--nest-gap", "7", "--seam-allowance", "6"])
     api = Bundle.of("flatten", values)
-    opts, batched = _options(None, None, None, dict(values, jobs=1))
+    _, batched = _options(None, None, None, dict(values, jobs=1))
     assert cli.to_json() == api.to_json() == batched.to_json() == values
     host = Bundle.from_json("pattern", {k: str(v) for k, v in values.items()})  # a host's text properties
     for slot in ("flatten", "check", "pieces", "nest"):
@@ -149,12 +149,12 @@ def test_the_worker_takes_a_bundles_json_form(tmp_path):
     request = {"id": 1, "op": "validate", "kind": "pattern", "name": "Cut", "options": bundle.to_json()}
     proc = subprocess.run([sys.executable, "-m", "patterns", "serve"], input=(
         '{"id": 0, "op": "hello", "protocol": 1}\n' + json.dumps(request) + "\n").encode(),
-        capture_output=True, timeout=300, env=dict(os.environ))
+        capture_output=True, timeout=300, env=dict(os.environ), check=False)
     replies = [json.loads(line) for line in proc.stdout.splitlines()]
     assert [r["ok"] for r in replies] == [True, True], replies
     bad = dict(request, options=dict(bundle.to_json(), dart_strain=5))
     proc = subprocess.run([sys.executable, "-m", "patterns", "serve"], input=(
         '{"id": 0, "op": "hello", "protocol": 1}\n' + json.dumps(bad) + "\n").encode(),
-        capture_output=True, timeout=300)
+        capture_output=True, timeout=300, check=False)
     reply = json.loads(proc.stdout.splitlines()[1])
     assert reply["error"]["message"].startswith("Cut: dart_strain must be a ratio"), reply

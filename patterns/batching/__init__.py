@@ -21,10 +21,9 @@ batch (Ctrl-C, SIGTERM) stops its workers and still returns its rows.
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable
 from pathlib import Path
-
-import warnings
 
 from ..bundle import Bundle
 from ..errors import InputError, PatternsError, Terminated
