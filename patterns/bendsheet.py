@@ -18,16 +18,18 @@ order: the rule depends on lengths only, never on where the blank lies.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import shapely
 from shapely.ops import split
 
-__all__ = ["COLUMNS", "TIE", "BendRow", "bend_rows", "flange_depths", "sequence"]
+__all__ = ["COLUMNS", "TIE", "BendRow", "bend_rows", "flange_depths", "numbered", "sequence"]
 
 TIE = 0.01
-"""mm: two outer flanges (or two bend lines) closer in length than this are equal for the sequence."""
+"""mm: two outer flanges (or two bend lines) closer in length than this are equal for the sequence: lengths are
+counted in its steps, so that the order is total and a near tie is not decided by round-off (the same part on
+another machine, or sampled otherwise, numbers its bends the same)."""
 
 COLUMNS = ("part", "sequence", "direction", "angle_deg", "inside_radius_mm", "bend_length_mm", "k_factor",
            "allowance_mm", "flange_mm", "x1_mm", "y1_mm", "x2_mm", "y2_mm")
@@ -92,6 +94,24 @@ def sequence(polygon: shapely.Polygon, lines) -> tuple:
     return _order([min(flange_depths(polygon, line)) for line in lines], lines)
 
 
+def numbered(polygon: shapely.Polygon, bends) -> tuple:
+    """The bends, each with its ``sequence`` (1 for the first to bend) and its outer ``flange`` depth, mm:
+    the one place a blank's bends are ordered (:class:`patterns.Blank` numbers its bends when it is made;
+    its pieces, the drawings, the report and the bend sheet read the numbers).
+
+    Parameters
+    ----------
+    polygon : shapely.Polygon
+        The blank, mm.
+    bends : sequence
+        Its bends: frozen dataclasses with ``line`` ((2, 2) float64, mm), ``sequence`` and ``flange``.
+    """
+    bends = list(bends)
+    outer = [min(flange_depths(polygon, b.line)) for b in bends]
+    rank = {i: k for k, i in enumerate(_order(outer, [b.line for b in bends]), start=1)}
+    return tuple(replace(b, sequence=rank[i], flange=outer[i]) for i, b in enumerate(bends))
+
+
 def _order(outer: list, lines) -> tuple:
     """:func:`sequence` from each bend's outer flange depth, mm, already measured."""
     length = [float(np.linalg.norm(np.subtract(*np.asarray(line).reshape(2, 2)))) for line in lines]
@@ -147,17 +167,16 @@ class BendRow:
         return {c: getattr(self, c) for c in COLUMNS}
 
 
-def bend_rows(part: str, polygon: shapely.Polygon, bends, *, scale: float = 1.0) -> tuple:
+def bend_rows(part: str, bends, *, scale: float = 1.0) -> tuple:
     """The bend sheet of one blank: a :class:`BendRow` per bend, in sequence.
 
     Parameters
     ----------
     part : str
-    polygon : shapely.Polygon
-        The blank, mm.
     bends : sequence
-        Its bends, each with ``line`` ((2, 2) float64, mm), ``direction``, ``angle``, ``inside_radius``,
-        ``k_factor`` and ``allowance`` (a :class:`patterns.blank.Bend` or a drawn piece's bend line).
+        Its bends, numbered (:func:`numbered`): each with ``sequence``, ``flange``, ``line`` ((2, 2) float64,
+        mm), ``direction``, ``angle``, ``inside_radius``, ``k_factor`` and ``allowance`` (a
+        :class:`patterns.blank.Bend` or a drawn piece's bend line).
     scale : float
         Lengths are multiplied by it (``1 / 25.4`` for inches).
 
@@ -165,15 +184,11 @@ def bend_rows(part: str, polygon: shapely.Polygon, bends, *, scale: float = 1.0)
     -------
     tuple of BendRow
     """
-    bends = list(bends)
-    outer = [min(flange_depths(polygon, b.line)) for b in bends]  # measured once: the order and the rows
-    order = _order(outer, [b.line for b in bends])
     rows = []
-    for rank, i in enumerate(order, start=1):
-        b = bends[i]
+    for b in sorted(bends, key=lambda b: b.sequence):
         (x1, y1), (x2, y2) = np.asarray(b.line, dtype=np.float64) * scale
-        rows.append(BendRow(part, rank, b.direction, float(b.angle), float(b.inside_radius) * scale,
+        rows.append(BendRow(part, b.sequence, b.direction, float(b.angle), float(b.inside_radius) * scale,
                             float(np.linalg.norm(np.subtract(*b.line))) * scale, b.k_factor,
-                            float(b.allowance) * scale, outer[i] * scale,
+                            float(b.allowance) * scale, float(b.flange) * scale,
                             float(x1), float(y1), float(x2), float(y2)))
     return tuple(rows)

@@ -18,7 +18,7 @@ from functools import cached_property
 import numpy as np
 import shapely
 
-from .bendsheet import bend_rows, sequence
+from .bendsheet import bend_rows, numbered
 from .curves import Arc, Loop, Motion
 from .findings import Finding, Severity
 
@@ -47,6 +47,11 @@ class Bend:
         The CAD faces of the bend (cylinders of the developed skin), ``shape.faces()`` indices.
     k_factor : float or None
         The K-factor the bend was developed with; None when a bend table gave it.
+    sequence : int
+        Its place in the press brake's order, 1 for the first bend to make
+        (:func:`patterns.bendsheet.sequence`): numbered once, when the blank is made (0 until then).
+    flange : float
+        The depth of its outer flange, mm (what the order sorts by), measured with the sequence.
     """
 
     line: np.ndarray
@@ -56,6 +61,8 @@ class Bend:
     allowance: float
     faces: tuple
     k_factor: float | None = None
+    sequence: int = 0
+    flange: float = 0.0
 
     def __post_init__(self):
         line = np.array(self.line, dtype=np.float64).reshape(2, 2)
@@ -168,6 +175,10 @@ class Blank:
     material: str | None = None
     rims: tuple = ()
 
+    def __post_init__(self):
+        if any(b.sequence == 0 for b in self.bends):  # numbered once, here; a moved blank keeps its numbers
+            object.__setattr__(self, "bends", numbered(self.polygon, self.bends))
+
     @property
     def ok(self) -> bool:
         """No finding that stops the blank being cut."""
@@ -204,7 +215,7 @@ class Blank:
         """The press brake's bend sheet: one :class:`~patterns.bendsheet.BendRow` per bend, in the order to
         bend them (outside-in, :func:`patterns.bendsheet.sequence`), lengths in mm, the bend lines' ends in
         the blank's own coordinates (``patterns.write(blank, "bends.csv")`` writes them in the DXF's)."""
-        return bend_rows(self.name, self.polygon, self.bends)
+        return bend_rows(self.name, self.bends)
 
     def moved(self, motion: Motion) -> Blank:
         """The blank moved rigidly (as laid out in a drawing or nested): outline, holes, rims, bend lines and the
@@ -217,7 +228,6 @@ class Blank:
     def to_dict(self) -> dict:
         """Size, area, usage, bends and findings, JSON-ready (the report's ``blanks`` entries)."""
         w, h = self.size
-        rank = {i: k for k, i in enumerate(sequence(self.polygon, [b.line for b in self.bends]), start=1)}
         return {
             "name": self.name, "ok": self.ok, "thickness_mm": round(self.thickness, 4),
             "k_factor": self.k_factor, "fixed_face": self.fixed_face,
@@ -225,9 +235,9 @@ class Blank:
             "outer_perimeter_mm": round(self.perimeter, 3), "holes": len(self.holes),
             "usage": round(self.usage, 4),
             "material": self.material,
-            "bends": [{"sequence": rank[i], "angle_deg": round(b.angle, 3), "inside_radius_mm": round(b.inside_radius, 4),
+            "bends": [{"sequence": b.sequence, "angle_deg": round(b.angle, 3), "inside_radius_mm": round(b.inside_radius, 4),
                        "direction": b.direction, "allowance_mm": round(b.allowance, 4), "k_factor": b.k_factor,
-                       "line": np.round(b.line, 4).tolist(), "faces": list(b.faces)} for i, b in enumerate(self.bends)],
+                       "line": np.round(b.line, 4).tolist(), "faces": list(b.faces)} for b in self.bends],
             "rims": [r.to_dict() for r in self.rims],
             "findings": [f.to_dict() for f in self.findings],
         }

@@ -48,6 +48,7 @@ from .files import atomic_output, child_python
 from .options import Options, check_number, label, option
 from .pieces import Drawing, Piece, PieceOptions, pieces_of
 from .pieces.drawing import place_nest
+from .pieces.labels import with_labels
 
 __all__ = ["ROTATIONS", "SHEET_SPACING", "Layout", "LayoutError", "NestOptions", "Sheet", "cache_folder", "layout"]
 
@@ -247,13 +248,15 @@ class Layout:
 
 
 def _with_copies(pieces: tuple, counts: list, mirror: bool) -> tuple:
-    """The pieces, then each one's extra copies (``face0 #2``) and, with ``mirror``, its mirror images."""
+    """The pieces, then each one's extra copies (``face0 #2``) and, with ``mirror``, its mirror images (each
+    titled with its own name: its labels placed once, here)."""
     extra = []
     for piece, n in zip(pieces, counts):
-        extra += [piece.copy(f"{piece.name} #{k + 1}", k) for k in range(1, n)]
+        extra += [with_labels(piece.copy(f"{piece.name} #{k + 1}", k)) for k in range(1, n)]
         if mirror:
-            extra += [piece.copy(f"{piece.name} mirrored" if k == 0 else f"{piece.name} #{k + 1} mirrored", n + k,
-                                 mirrored=True) for k in range(n)]
+            extra += [with_labels(piece.copy(f"{piece.name} mirrored" if k == 0 else
+                                             f"{piece.name} #{k + 1} mirrored", n + k, mirrored=True))
+                      for k in range(n)]
     return tuple(pieces) + tuple(extra)
 
 

@@ -18,7 +18,6 @@ from ..files import atomic_output
 from ..pieces import Drawing, Piece, piece_labels
 from ..pieces.allowance import straight_runs
 from ..units import Unit
-from .bendsheet import sequenced
 from .dxfdoc import add_loop, add_polyline, add_text, declare_linetypes, new_doc, r12_units, save
 from .layers import LayerMap
 from .options import WriteOptions
@@ -66,7 +65,6 @@ def _strain_solids(msp, piece: Piece, layer: str, scale: float, truecolor: bool)
 
 def _piece(msp, piece: Piece, layers: LayerMap, unit: Unit, options: WriteOptions, r12: bool) -> None:
     scale = 1.0 / unit.mm
-    piece = sequenced(piece)  # a blank's bend labels numbered in the bending sequence
 
     def line(a, b, layer):
         msp.add_line(tuple(np.asarray(a) * scale), tuple(np.asarray(b) * scale), dxfattribs={"layer": layer})

@@ -18,7 +18,6 @@ import numpy as np
 
 from ..files import atomic_output
 from ..pieces import MARGIN, Drawing, Piece, piece_labels
-from .bendsheet import SequencedBend, sequenced
 from .options import WriteOptions
 
 __all__ = ["REPORT_SCHEMA", "piece_dict", "write"]
@@ -36,7 +35,6 @@ def _xy(points) -> list:
 
 def piece_dict(piece: Piece) -> dict:
     """One piece as the JSON report gives it (mm, the drawing's frame)."""
-    piece = sequenced(piece)  # a blank's bends numbered in the bending sequence, as the DXF labels them
     m = piece.placement
     return {
         "name": piece.name,
@@ -53,7 +51,8 @@ def piece_dict(piece: Piece) -> dict:
                     for n in piece.notches],
         "drills": _xy(piece.drills),
         "grain": None if piece.grain is None else _xy(piece.grain),
-        "bends": [{"line": _xy(b.line), "sequence": b.sequence if isinstance(b, SequencedBend) else None, "angle_deg": round(b.angle, 4), "direction": b.direction,
+        "bends": [{"line": _xy(b.line), "sequence": b.sequence or None,
+                   "angle_deg": round(b.angle, 4), "direction": b.direction,
                    "inside_radius_mm": b.inside_radius, "k_factor": b.k_factor,
                    "allowance_mm": None if b.allowance is None else round(b.allowance, 4)} for b in piece.bends],
         "seams": [{"seam": s.seam, "side": s.side, "length_3d_mm": s.length_3d, "length_flat_mm": s.length_flat}

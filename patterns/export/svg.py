@@ -30,7 +30,6 @@ from ..files import atomic_output
 from ..pieces import MARGIN, Drawing, piece_labels
 from ..pieces.allowance import straight_runs
 from ..units import Unit
-from .bendsheet import sequenced
 from .options import WriteOptions
 
 __all__ = ["COLOURS", "write"]
@@ -111,7 +110,7 @@ def write(drawing: Drawing, path, options: WriteOptions) -> None:
             score.append(f'<path d="{page.polyline(piece.grain, False)}"/>')
         if options.bend_lines:
             score += [f'<path d="{page.polyline(b.line, False)}" stroke-dasharray="3 2"/>' for b in piece.bends]
-        for label in piece_labels(sequenced(piece), Unit.MM):  # a blank's bends numbered in sequence
+        for label in piece_labels(piece, Unit.MM):
             if label.kind == "bend" and not options.bend_lines:
                 continue
             x, y = label.at[0], height - label.at[1]

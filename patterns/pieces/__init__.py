@@ -10,15 +10,16 @@ Layers point down: patterns and blanks (:mod:`patterns.pattern`,
   :class:`PieceOptions` (seam allowance, notches, rulings, arcs, text height);
 * :class:`Drawing`, :func:`drawing_of`: pieces laid out in the one frame a
   file's every writer uses (:mod:`~patterns.pieces.drawing`);
-* :func:`~patterns.pieces.labels.piece_labels`: a piece's labels, placed
-  inside it clear of each other.
+* :class:`Labels`: a piece's labels, placed once inside it clear of each other
+  when the piece is made, kept on it and moved with it; a writer reads them
+  with :func:`~patterns.pieces.labels.piece_labels`.
 """
 
 from .build import blank_piece, pieces_of
 from .drawing import MARGIN, Drawing, arrange, drawing_of
-from .labels import Label, piece_labels
+from .labels import piece_labels
 from .options import PieceOptions, check_marks
-from .piece import BendLine, Notch, Piece, SeamSide, Source, StrainMap
+from .piece import BendLine, Label, Labels, Notch, Piece, SeamSide, Source, StrainMap
 
-__all__ = ["MARGIN", "BendLine", "Drawing", "Label", "Notch", "Piece", "PieceOptions", "SeamSide", "Source",
+__all__ = ["MARGIN", "BendLine", "Drawing", "Label", "Labels", "Notch", "Piece", "PieceOptions", "SeamSide", "Source",
            "StrainMap", "arrange", "blank_piece", "check_marks", "drawing_of", "piece_labels", "pieces_of"]

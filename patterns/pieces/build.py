@@ -6,9 +6,10 @@ countersunk holes, to mark), its bend lines with
 their direction, angle, inside radius and K-factor, and its findings.  A list
 of patterns, blanks and pieces gives all their pieces, named
 ``"<part>/<piece>"`` when more than one part is in it.  Each piece made here
-also carries a ``label-left-out`` note for every label that does not fit on it
-at the least text height (:func:`~patterns.pieces.labels.label_findings`): the
-writers leave that label out.
+keeps its labels, placed once (:func:`~patterns.pieces.labels.place_labels`), and
+a ``label-left-out`` note for every label that does not fit on it at the least
+text height (:func:`~patterns.pieces.labels.label_findings`): the writers leave
+that label out.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from ..findings import Finding
 from ..pattern import Pattern
 from ..text import printable
 from .allowance import allowance_lookup
-from .labels import label_findings
+from .labels import label_findings, with_labels
 from .options import PieceOptions, check_marks
 from .panel import panel_piece, text_height_for
 from .piece import BendLine, Piece, Source
@@ -45,8 +46,8 @@ def blank_piece(blank: Blank, options: PieceOptions | None = None) -> Piece:
         name=printable(blank.name), outline=blank.outline, holes=blank.holes,
         sew=tuple([blank.outline.points(0.01)] + [h.points(0.01) for h in blank.holes]), allowance=False,
         notches=(), drills=np.zeros((0, 2)), grain=None,
-        bends=tuple(BendLine(b.line, b.angle, b.direction, b.inside_radius, b.k_factor, b.allowance)
-                    for b in blank.bends),
+        bends=tuple(BendLine(b.line, b.angle, b.direction, b.inside_radius, b.k_factor, b.allowance,
+                             sequence=b.sequence, of=len(blank.bends), flange=b.flange) for b in blank.bends),
         seams=(), title=(f"T {blank.thickness:g} MM  {how}  {w:.1f} x {h:.1f} MM",),
         text_height=text_height_for(max(w, h), options.text_height), label_at=label_at,
         source=Source("blank", blank.name, 0, tuple(faces)), strain=None, findings=blank.findings, rims=blank.rims)
@@ -105,5 +106,8 @@ def pieces_of(source, options: PieceOptions | None = None, *, findings: Iterable
     for part, ps, prefix, made in groups:
         for p in ps:
             p = replace(p, name=f"{printable(part)}/{p.name}") if several and prefix else p
-            out.append(replace(p, findings=tuple(p.findings) + label_findings(p)) if made else p)
+            if made:  # its labels placed once, here, and kept: the notes and every writer read them
+                p = with_labels(p)
+                p = replace(p, findings=tuple(p.findings) + label_findings(p))
+            out.append(p)
     return tuple(out)

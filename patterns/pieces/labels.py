@@ -11,11 +11,20 @@ one was asked for): one that fits nowhere at that height is left out rather
 than shrunk or drawn across a cut, and :func:`label_findings` says so (a
 ``label-left-out`` note on the piece).  Boxes are measured with ezdxf's font
 metrics of the standard style, 10 % wider for readers with wider fonts.
+
+A piece's labels are placed once, when :func:`~patterns.pieces.pieces_of` makes
+it (:func:`place_labels`), in mm, and kept on the piece (``Piece.labels``), moved
+with it by the layout and the nester; the notes, the DXF, SVG and JSON writers
+and the worker all read those.  A seam label's place is reserved for its text
+in the widest of the units (``S1 3D 12.3456 FLAT 12.3456 cm``), so that a writer
+in any unit only rewrites its text (:func:`piece_labels`).  ASTM's title block
+(the standard's annotation lines) is its own: it alone is placed by that
+writer, clear of the piece's other labels.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import replace
 from functools import lru_cache
 
 import numpy as np
@@ -23,10 +32,10 @@ import shapely
 
 from ..findings import Code, Finding, Severity
 from ..units import Unit
-from .piece import Piece, SeamSide
+from .piece import Label, Labels, Piece, SeamSide
 
-__all__ = ["LEAST_TEXT_HEIGHT", "Label", "LabelPlacer", "label_findings", "least_height", "piece_labels",
-           "readable_angle", "seam_text", "text_box"]
+__all__ = ["LEAST_TEXT_HEIGHT", "Label", "LabelPlacer", "Labels", "label_findings", "labels_of", "least_height",
+           "piece_labels", "place_labels", "readable_angle", "seam_text", "text_box", "with_labels"]
 
 SCALES = (1.0, 0.8, 0.64, 0.5, 0.4, 0.33)
 """The sizes a label is tried at, as fractions of the size it asks for (never below the least height)."""
@@ -70,20 +79,6 @@ def text_box(text: str, at, height: float, angle: float, *, widen: float = 1.1) 
     a = np.radians(angle)
     rot = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
     return shapely.Polygon(corners @ rot.T + np.asarray(at, dtype=np.float64))
-
-
-@dataclass(frozen=True)
-class Label:
-    """A placed label: its text, centre (2,) mm, cap height mm and angle (degrees), and what it says:
-    ``"title"`` (the piece's name and what it is), ``"seam"`` (a seam side's lengths) or ``"bend"``."""
-
-    text: str
-    at: np.ndarray
-    height: float
-    angle: float
-    kind: str = "title"
-    of: int = -1
-    """A seam label's index in :attr:`Piece.seams`, a bend label's in :attr:`Piece.bends` (-1 for the title)."""
 
 
 class LabelPlacer:
@@ -249,10 +244,13 @@ def _place_all(piece: Piece, unit: Unit, block, *, title_first: bool) -> LabelPl
         _title(placer, piece, block, angles)
     for k, side in enumerate(piece.seams):
         text = seam_text(side, unit)
+        wide = _widest(side)  # its place is reserved for its text in any unit: a writer only rewrites it
         h = max(0.6 * th, placer.least)
         tries = along(side.points, 1.6 * h)
-        if not any(placer.place(text, [place], h, readable_angle(tangent), kind="seam", of=k, note=False)
-                   for place, tangent in tries):
+        if any(placer.place(wide, [place], h, readable_angle(tangent), kind="seam", of=k, note=False)
+               for place, tangent in tries):
+            placer.labels[-1] = replace(placer.labels[-1], text=text)
+        else:
             placer.left_out.append(Label(text, tries[0][0], h, readable_angle(tries[0][1]), "seam", k))
     for k, bend in enumerate(piece.bends):
         a, b = bend.line
@@ -278,10 +276,38 @@ def _place_all(piece: Piece, unit: Unit, block, *, title_first: bool) -> LabelPl
     return placer
 
 
+def _widest(side: SeamSide) -> str:
+    """The seam label's text in the unit that writes it widest (its place is kept for that one)."""
+    return max((seam_text(side, unit) for unit in Unit), key=lambda t: text_width(t, 1.0))
+
+
+def place_labels(piece: Piece) -> Labels:
+    """Every label of a piece placed clear of the others inside the finished piece, in mm, none below the least
+    height (:func:`least_height`), and those that fit nowhere: what ``Piece.labels`` keeps.
+
+    The title block (the piece's name at 1.2 text heights and the first line of its title at 0.7; level, or
+    along a narrow piece's length where it fits only so), then one label per seam side (``"seam"``, 0.6 text
+    heights, along the seam and 1.6 label heights inside it, its middle first, its place kept for its text in
+    any unit), then one per bend line (``"bend"``, half a text height, centred on the line, or across it beside
+    its middle when the line is too short; a blank's bends numbered in the bending order).
+    """
+    placer = _placer(piece, Unit.MM, None)
+    return Labels(tuple(placer.labels), tuple(placer.left_out), placer.least)
+
+
+def labels_of(piece: Piece) -> Labels:
+    """The piece's labels: those it keeps (``Piece.labels``), or, for a piece made without, placed now."""
+    return piece.labels if piece.labels is not None else place_labels(piece)
+
+
+def with_labels(piece: Piece) -> Piece:
+    """The piece with its labels placed and kept (itself when it has them)."""
+    return piece if piece.labels is not None else replace(piece, labels=place_labels(piece))
+
+
 def piece_labels(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> list:
-    """Every label of a piece, each placed clear of the others inside the finished piece, none below the
-    least height (:func:`least_height`): one that does not fit there is left out
-    (:func:`label_findings` says which).
+    """Every label of a piece as a writer in ``unit`` draws it: its kept labels (:func:`labels_of`), a seam's
+    text in ``unit``; places in mm.
 
     Parameters
     ----------
@@ -289,28 +315,37 @@ def piece_labels(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> list:
     unit : patterns.Unit
         The drawing's unit (the seam labels say it).
     block : list of (str, float, float), optional
-        The title block, as :meth:`LabelPlacer.place_block` takes it; default the piece's name
-        (1.2 text heights) and the first line of its title (0.7).
+        Another title block (ASTM's annotation lines), as :meth:`LabelPlacer.place_block` takes it: placed
+        clear of the piece's other labels, instead of its own title.
 
     Returns
     -------
     list of Label
-        The title block (kind ``"title"``: level, or along a narrow piece's length where it fits only
-        so), then one label per seam side (``"seam"``, 0.6 text heights, along the seam and 1.6 label
-        heights inside it, its middle first), then one per bend line (``"bend"``, half a text height,
-        centred on the line, or across it beside its middle when the line is too short).
+        The title block (kind ``"title"``), then the seam labels (``"seam"``), then the bend labels
+        (``"bend"``); those that fit nowhere are left out (:func:`label_findings`).
     """
-    return _placer(piece, unit, block).labels
+    kept = labels_of(piece)
+    out = [replace(label, text=seam_text(piece.seams[label.of], unit)) if label.kind == "seam" and unit is not Unit.MM
+           else label for label in kept.placed]
+    if block is None:
+        return out
+    placer = LabelPlacer(piece.finished, kept.least)
+    others = [label for label in out if label.kind != "title"]
+    placer.boxes = [text_box(_widest(piece.seams[label.of]) if label.kind == "seam" else label.text, label.at,
+                             label.height, label.angle) for label in others]
+    turned = _long_axis(piece.finished)
+    _title(placer, piece, block, (0.0,) if abs(turned) < 1e-6 else (0.0, turned))
+    return placer.labels + others
 
 
-def label_findings(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> tuple:
-    """One ``label-left-out`` note per label of ``piece`` that fits nowhere on it at the least height
-    (:func:`piece_labels` leaves it out): which label, on which piece, and where it was wanted."""
-    placer = _placer(piece, unit, block)
+def label_findings(piece: Piece) -> tuple:
+    """One ``label-left-out`` note per label of ``piece`` that fits nowhere on it at the least text height
+    (the writers leave it out): which label, on which piece, and where it was wanted."""
+    kept = labels_of(piece)
     what = f"panel {piece.name}" if piece.source.kind == "panel" else piece.name
     out = []
-    for label in placer.left_out:
+    for label in kept.left_out:
         out.append(Finding(Code.LABEL_LEFT_OUT, Severity.NOTE, (piece.name,), label.at[None, :], (), None,
                            f"{what}: {label.kind} label {label.text!r} does not fit on the piece at the least text "
-                           f"height ({placer.least:g} mm): left out"))
+                           f"height ({kept.least:g} mm): left out"))
     return tuple(out)

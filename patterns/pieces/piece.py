@@ -24,7 +24,7 @@ import shapely
 from ..curves import Loop, Motion
 from ..measure import StrainStats
 
-__all__ = ["BendLine", "Notch", "Piece", "SeamSide", "Source", "StrainMap"]
+__all__ = ["BendLine", "Label", "Labels", "Notch", "Piece", "SeamSide", "Source", "StrainMap"]
 
 
 def _frozen(array, shape=None) -> np.ndarray:
@@ -91,6 +91,13 @@ class BendLine:
         The K-factor it was developed with (None: a bend table, or a ruling).
     allowance : float or None
         The developed width of the bend zone, mm (a blank's bend).
+    sequence : int
+        A blank's bend: its place in the press brake's order (1 first), as the blank numbered it; 0 for a
+        ruling.
+    of : int
+        How many bends the blank has (a blank of one bend has no order to give: its label has no number).
+    flange : float
+        A blank's bend: its outer flange's depth, mm (the bend sheet's ``flange_mm``).
     """
 
     line: np.ndarray
@@ -99,15 +106,20 @@ class BendLine:
     inside_radius: float | None = None
     k_factor: float | None = None
     allowance: float | None = None
+    sequence: int = 0
+    of: int = 0
+    flange: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "line", _frozen(self.line, (2, 2)))
 
     @property
     def label(self) -> str:
-        """The text drawn beside it: ``UP 90.0 DEG R3`` for a blank's bend, ``BEND 11.61 DEG`` for a ruling."""
+        """The text drawn beside it: ``1 UP 90.0 DEG R3`` for a blank's bend (its number in the bending order
+        first, when the blank has two bends or more), ``BEND 11.61 DEG`` for a ruling."""
         if self.direction:
-            return f"{self.direction.upper()} {self.angle:.1f} DEG R{self.inside_radius:g}"
+            number = f"{self.sequence} " if self.of > 1 else ""
+            return f"{number}{self.direction.upper()} {self.angle:.1f} DEG R{self.inside_radius:g}"
         return f"BEND {self.angle:.2f} DEG"
 
     def moved(self, motion: Motion) -> BendLine:
@@ -166,6 +178,67 @@ class StrainMap:
 
     def moved(self, motion: Motion) -> StrainMap:
         return StrainMap(motion(self.triangles.reshape(-1, 2)).reshape(-1, 3, 2), self.strain)
+
+
+@dataclass(frozen=True, eq=False)
+class Label:
+    """A placed label: its text, centre (2,) mm, cap height mm and angle (degrees), and what it says:
+    ``"title"`` (the piece's name and what it is), ``"seam"`` (a seam side's lengths) or ``"bend"``.
+
+    Its box (:func:`patterns.pieces.labels.text_box`) reaches from a descender a quarter height below the
+    baseline to the cap height: a label turned upside down by a move is turned back to read left to right
+    and shifted that quarter height, so that it covers the same place (:meth:`moved`)."""
+
+    text: str
+    at: np.ndarray
+    height: float
+    angle: float
+    kind: str = "title"
+    of: int = -1
+    """A seam label's index in :attr:`Piece.seams`, a bend label's in :attr:`Piece.bends` (-1 for the title)."""
+
+    def __post_init__(self):
+        object.__setattr__(self, "at", _frozen(self.at, (2,)))
+
+    def moved(self, motion: Motion) -> Label:
+        a = np.radians(self.angle)
+        along, up = motion.direction(np.array([np.cos(a), np.sin(a)])), motion.direction(np.array([-np.sin(a),
+                                                                                                     np.cos(a)]))
+        angle = float(np.degrees(np.arctan2(along[1], along[0])))
+        if angle > 90 + 1e-6:  # read left to right, as readable_angle turns it (a vertical text stays at 90,
+            angle -= 180      # whichever way round-off leans)
+        elif angle <= -90 + 1e-6:
+            angle += 180
+        r = np.radians(angle)
+        new_up = np.array([-np.sin(r), np.cos(r)])
+        at = motion(self.at)
+        if float(up @ new_up) < 0:  # upside down, turned back: the box's descender on the other side
+            at = at + 0.25 * self.height * new_up
+        return replace(self, at=at, angle=angle)
+
+
+@dataclass(frozen=True, eq=False)
+class Labels:
+    """A piece's labels, placed once (:func:`patterns.pieces.labels.place_labels`) and moved with it.
+
+    Attributes
+    ----------
+    placed : tuple of Label
+        The title block, then the seam labels, then the bend labels.
+    left_out : tuple of Label
+        Those that fit nowhere on the piece at the least height, as they asked to be drawn (each a
+        ``label-left-out`` note on the piece).
+    least : float
+        The least height any label was tried at, mm.
+    """
+
+    placed: tuple
+    left_out: tuple
+    least: float
+
+    def moved(self, motion: Motion) -> Labels:
+        return Labels(tuple(label.moved(motion) for label in self.placed),
+                      tuple(label.moved(motion) for label in self.left_out), self.least)
 
 
 @dataclass(frozen=True)
@@ -234,6 +307,9 @@ class Piece:
     rims : tuple of patterns.blank.Rim
         A blank's countersinks' and counterbores' rims: circles marked, not cut (the hole is cut at its
         through diameter, one of ``holes``).
+    labels : Labels or None
+        Its labels, placed when the piece was made (:func:`patterns.pieces.pieces_of`) and moved with it;
+        None for a piece made otherwise (the writers then place them: :func:`patterns.pieces.labels.labels_of`).
     """
 
     name: str
@@ -255,6 +331,7 @@ class Piece:
     strain_map: StrainMap | None = None
     placement: Motion = field(default_factory=Motion)
     rims: tuple = ()
+    labels: Labels | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "sew", tuple(_frozen(s, (-1, 2)) for s in self.sew))
@@ -295,12 +372,14 @@ class Piece:
             seams=tuple(s.moved(motion) for s in self.seams), label_at=motion(self.label_at),
             findings=tuple(f.moved(motion) for f in self.findings),
             strain_map=None if self.strain_map is None else self.strain_map.moved(motion),
-            placement=motion @ self.placement, rims=tuple(r.moved(motion) for r in self.rims))
+            placement=motion @ self.placement, rims=tuple(r.moved(motion) for r in self.rims),
+            labels=None if self.labels is None else self.labels.moved(motion))
 
     def copy(self, name: str, number: int, *, mirrored: bool = False) -> Piece:
         """Another piece of the same, named ``name`` (its ``number``-th copy); ``mirrored``: its mirror image
-        (across its own vertical line through ``label_at``)."""
-        piece = replace(self, name=name, source=replace(self.source, copy=number))
+        (across its own vertical line through ``label_at``).  Its title says another name: its labels are
+        placed anew (``labels`` None until then)."""
+        piece = replace(self, name=name, source=replace(self.source, copy=number), labels=None)
         if not mirrored:
             return piece
         x = float(self.label_at[0])
