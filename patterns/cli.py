@@ -217,11 +217,28 @@ def _table(rows):
         print("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
 
 
-def _verdict(report) -> int:
+def _verdict(report, drawing=None) -> int:
     print(str(report).splitlines()[0])
     for f in report.findings:
         print(f"  {f.severity.value}: {f.message}")
+    if drawing is not None:
+        _label_notes(drawing)
     return EXIT_OK if report.ok else EXIT_CHECK
+
+
+_MOST_NOTES = 10
+"""Label notes printed at most (the report has every one)."""
+
+
+def _label_notes(drawing) -> None:
+    """The labels the file leaves out, one note each (the same the report gives its pieces)."""
+    from .findings import Code
+
+    notes = [f for p in drawing.pieces for f in p.findings if f.code is Code.LABEL_LEFT_OUT]
+    for f in notes[:_MOST_NOTES]:
+        print(f"  {f.severity.value}: {f.message}")
+    if len(notes) > _MOST_NOTES:
+        print(f"  ... and {len(notes) - _MOST_NOTES} more labels left out (the report lists them)")
 
 
 def _loaded(model, seconds):
@@ -305,7 +322,7 @@ def _cmd_flatten(args) -> int:
     _nested(part.nest)
     _print_panels(part.report)
     _wrote(run, bundle)
-    return _verdict(part.report)
+    return _verdict(part.report, part.drawing if "pattern" in run.outputs else None)
 
 
 def _cmd_check(args) -> int:
@@ -473,6 +490,8 @@ def _cmd_unfold(args) -> int:
         _table(rows)
     for f in blank.findings:
         print(f"  {f.severity.value}: {f.message}")
+    if blank.ok:
+        _label_notes(part.drawing)
     c = part.comparison
     if c is not None:
         print(f"against {args.compare}: area {c.area_error:+.4%}, outer perimeter {c.perimeter - c.perimeter_reference:+.3f}"

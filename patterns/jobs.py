@@ -183,10 +183,11 @@ class PartResult:
 
 def _laid_out(subject, bundle: Bundle) -> tuple:
     """``(drawing, nest or None)``: the subject's pieces, nested when the bundle gives a roll or sheet."""
+    unit = bundle.write.units  # the labels placed once, for the file's unit
     if bundle.nest.active:
-        nest = layout(subject, bundle.nest, pieces=bundle.pieces)
+        nest = layout(subject, bundle.nest, pieces=bundle.pieces, unit=unit)
         return nest.drawing(), nest
-    return drawing_of(subject, bundle.pieces), None
+    return drawing_of(subject, bundle.pieces, unit=unit), None
 
 
 def _write(subject, drawing: Drawing, checked: Drawing, options: WriteOptions, outputs: dict,

@@ -252,16 +252,17 @@ def _with_copies(pieces: tuple, counts: list, mirror: bool) -> tuple:
     titled with its own name: its labels placed once, here)."""
     extra = []
     for piece, n in zip(pieces, counts):
-        extra += [with_labels(piece.copy(f"{piece.name} #{k + 1}", k)) for k in range(1, n)]
+        unit = "mm" if piece.labels is None else piece.labels.unit
+        extra += [with_labels(piece.copy(f"{piece.name} #{k + 1}", k), unit) for k in range(1, n)]
         if mirror:
             extra += [with_labels(piece.copy(f"{piece.name} mirrored" if k == 0 else
-                                             f"{piece.name} #{k + 1} mirrored", n + k, mirrored=True))
+                                             f"{piece.name} #{k + 1} mirrored", n + k, mirrored=True), unit)
                       for k in range(n)]
     return tuple(pieces) + tuple(extra)
 
 
 def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions | None = None,
-           **keywords) -> Layout:
+           unit: str = "mm", **keywords) -> Layout:
     """Nest pieces on a roll or on sheets (sparrow), checked with shapely.
 
     Parameters
@@ -279,6 +280,9 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
     pieces : patterns.pieces.PieceOptions, optional
         What goes onto each piece (the seam allowance is part of its outline); keywords (``seam_allowance``,
         ...) go over it.
+    unit : str
+        The unit the pieces' seam labels say (the file's: default mm); their labels are placed once, for it,
+        and move with them.
 
     Returns
     -------
@@ -300,7 +304,7 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
     if not opts.active:
         raise InputError(f"{name}: give a roll width or a sheet to nest on")
     deadline += opts.time_limit
-    base = pieces_of(source, pieces, **{k: v for k, v in keywords.items() if k not in nest_fields})
+    base = pieces_of(source, pieces, unit=unit, **{k: v for k, v in keywords.items() if k not in nest_fields})
     names = [p.name for p in base]
     counts = [opts.copies] * len(names)
     for piece_name, n in (opts.quantities or {}).items():

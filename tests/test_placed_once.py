@@ -82,39 +82,43 @@ def test_a_flatten_that_writes_dxf_svg_and_report_places_each_pieces_labels_once
     drawing = patterns.pieces.drawing_of(pattern)
     assert counted["placer"] == len(drawing.pieces) == len(pattern.panels)
     report, checked = patterns.audit.checked_drawing(pattern, drawing, patterns.CheckOptions())
-    for name in ("cup.dxf", "cup.svg", "cup_cm.dxf"):
-        patterns.write(drawing, tmp_path / name, units="cm" if "cm" in name else "mm")
+    for name in ("cup.dxf", "cup.svg"):
+        patterns.write(drawing, tmp_path / name)
     patterns.write(checked, tmp_path / "cup.json")
     patterns.write(drawing, tmp_path / "cup_astm.dxf", profile="astm")  # ASTM places its own title block only
     assert counted["placer"] == len(pattern.panels)
+    patterns.write(drawing, tmp_path / "cup_cm.dxf", units="cm")  # a drawing made for mm, written in cm: anew
+    assert counted["placer"] == 2 * len(pattern.panels)
     said = json.loads((tmp_path / "cup.json").read_text())["pieces"]
     for kept, written in zip(drawing.pieces, said):
         assert [label.text for label in kept.labels.placed] == [label["text"] for label in written["labels"]]
 
 
-def test_a_seam_label_in_centimetres_is_drawn_where_the_millimetre_one_is(tmp_path):
-    """The place is kept for the widest unit's text: the cm file's seam labels sit where the mm file's do,
-    say the same lengths in cm, and their glyphs lie inside their piece (read back, drawn by ezdxf)."""
+def test_a_drawing_in_centimetres_is_labelled_once_in_centimetres(tmp_path, counted):
+    """``patterns flatten -o x.dxf --units cm --report``: the seam labels are placed for their cm text, once per
+    piece; the DXF and the report say the same texts, and each DXF text's glyphs lie inside their piece."""
     from ezdxf.addons import text2path
 
-    pattern = patterns.flatten(patterns.load(bd.Box(200, 100, 50) - bd.Cylinder(20, 50)))
-    patterns.write(pattern, tmp_path / "mm.dxf")
-    patterns.write(pattern, tmp_path / "cm.dxf", units="cm")
-    seam = re.compile(r"S(\d+) 3D ([\d.]+) FLAT ([\d.]+) (MM|CM)")
-    mm = [(t.dxf.text, np.array(t.dxf.align_point)[:2]) for t in ezdxf.readfile(tmp_path / "mm.dxf").modelspace()
-          .query("TEXT") if seam.fullmatch(t.dxf.text)]
-    cm = ezdxf.readfile(tmp_path / "cm.dxf")
-    cuts = [shapely.Polygon([p[:2] for p in e.get_points("xy")]) for e in cm.modelspace().query("LWPOLYLINE[layer=='CUT']")]
-    seams = [t for t in cm.modelspace().query("TEXT") if seam.fullmatch(t.dxf.text)]
-    assert len(seams) == len(mm) == 2 * len(pattern.seams)
-    for text in seams:
-        number, three_d, flat, unit = seam.fullmatch(text.dxf.text).groups()
-        assert unit == "CM"
-        at = np.array(text.dxf.align_point)[:2] * 10
-        twins = [k for k, where in mm if np.allclose(where, at, atol=1e-6)]
-        assert twins == [f"S{number} 3D {float(three_d) * 10:.2f} FLAT {float(flat) * 10:.2f} MM"], text.dxf.text
+    step = tmp_path / "box.step"
+    bd.export_step(bd.Box(200, 100, 50) - bd.Cylinder(20, 50), str(step))
+    assert main(["flatten", str(step), "-o", str(tmp_path / "cm.dxf"), "--units", "cm", "--report",
+                 str(tmp_path / "r.json")]) == 0
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert counted["placer"] == len(report["pieces"])
+    seam = re.compile(r"S(\d+) 3D ([\d.]+) FLAT ([\d.]+) CM")
+    doc = ezdxf.readfile(tmp_path / "cm.dxf")
+    texts = [t for t in doc.modelspace().query("TEXT") if seam.fullmatch(t.dxf.text)]
+    said = [label["text"] for piece in report["pieces"] for label in piece["labels"] if label["kind"] == "seam"]
+    assert sorted(t.dxf.text for t in texts) == sorted(said) and len(said) == 2 * len(report["seams"])
+    for text in texts:
+        number, three_d, _ = seam.fullmatch(text.dxf.text).groups()
+        (length,) = [s["length_3d"] for s in report["seams"] if s["id"] == int(number)]
+        assert float(three_d) == pytest.approx(length / 10, abs=5e-5)
+    cuts = [shapely.Polygon([p[:2] for p in e.get_points("xy")])
+            for e in doc.modelspace().query("LWPOLYLINE[layer=='CUT']")]
+    for text in doc.modelspace().query("TEXT"):
         glyphs = shapely.MultiPoint([(v.x, v.y) for p in text2path.make_paths_from_entity(text)
-                                     for v in p.flattening(0.001)]).convex_hull
+                                     for v in p.flattening(0.0001)]).convex_hull
         assert any(c.contains(glyphs) for c in cuts), text.dxf.text
 
 
@@ -135,3 +139,17 @@ def test_labels_a_nest_turned_lie_inside_their_piece_clear_of_each_other():
         if piece.source.copy == 0:  # the piece itself: its labels are the unnested piece's, moved
             (original,) = [p for p in flat.pieces if p.name == piece.name]
             assert [label.text for label in placed] == [label.text for label in original.labels.placed]
+
+
+def test_the_command_line_prints_the_labels_the_file_leaves_out(tmp_path, capsys):
+    """An 8 mm cube: its faces hold few labels at 2 mm. The run's printout names the same left-out labels as
+    the report's pieces (the first ten, then how many more), worked out once, on the pieces as written."""
+    step = tmp_path / "cube.step"
+    bd.export_step(bd.Box(8, 8, 8), str(step))
+    assert main(["flatten", str(step), "-o", str(tmp_path / "cube.dxf"), "--report", str(tmp_path / "r.json")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    report = json.loads((tmp_path / "r.json").read_text())
+    notes = [f["message"] for piece in report["pieces"] for f in piece["findings"] if f["code"] == "label-left-out"]
+    printed = [line[len("  note: "):] for line in out if "label" in line and line.startswith("  note: ")]
+    assert len(notes) > 10 and printed == notes[:10]
+    assert f"  ... and {len(notes) - 10} more labels left out (the report lists them)" in out

@@ -86,7 +86,7 @@ def write(source, path, options: WriteOptions | None = None, *, pieces: PieceOpt
         raise InputError(f"{path}: arcs are written in the machine profile only")
     what = "report" if profile.name == "json" else f"{profile.suffix[1:].upper()} file"
     output_target(path, what=what)  # before the drawing: a path that cannot be written fails at once
-    drawing = _drawing(source, piece_opts)
+    drawing = _drawing(source, piece_opts, opts.units if profile.name == "machine" else "mm")
     if profile.name == "json":
         if drawing.report is None and not isinstance(source, (Drawing, Layout)):
             drawing = checked_drawing(source, drawing, CheckOptions.of(check, check_keywords, name=str(path)))[1]
@@ -97,9 +97,9 @@ def write(source, path, options: WriteOptions | None = None, *, pieces: PieceOpt
     profile.write(drawing, path, opts)
 
 
-def _drawing(source, piece_opts: PieceOptions) -> Drawing:
+def _drawing(source, piece_opts: PieceOptions, unit: str) -> Drawing:
     if isinstance(source, Drawing):
         return source
     if isinstance(source, Layout):
         return source.drawing()
-    return drawing_of(source, piece_opts)
+    return drawing_of(source, piece_opts, unit=unit)  # its labels placed once, in the file's unit

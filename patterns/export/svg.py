@@ -110,7 +110,7 @@ def write(drawing: Drawing, path, options: WriteOptions) -> None:
             score.append(f'<path d="{page.polyline(piece.grain, False)}"/>')
         if options.bend_lines:
             score += [f'<path d="{page.polyline(b.line, False)}" stroke-dasharray="3 2"/>' for b in piece.bends]
-        for label in piece_labels(piece, Unit.MM):
+        for label in piece_labels(piece, Unit.MM):  # as the piece keeps them (placed anew only if not in mm)
             if label.kind == "bend" and not options.bend_lines:
                 continue
             x, y = label.at[0], height - label.at[1]

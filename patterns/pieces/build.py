@@ -25,6 +25,7 @@ from ..errors import InputError
 from ..findings import Finding
 from ..pattern import Pattern
 from ..text import printable
+from ..units import Unit
 from .allowance import allowance_lookup
 from .labels import label_findings, with_labels
 from .options import PieceOptions, check_marks
@@ -61,7 +62,7 @@ def _pattern_pieces(pattern: Pattern, options: PieceOptions, findings) -> list:
 
 
 def pieces_of(source, options: PieceOptions | None = None, *, findings: Iterable[Finding] = (),
-              **keywords) -> tuple:
+              unit: Unit | str = Unit.MM, **keywords) -> tuple:
     """The pieces to cut of a pattern, a blank, a piece, or a list of them.
 
     Parameters
@@ -72,6 +73,9 @@ def pieces_of(source, options: PieceOptions | None = None, *, findings: Iterable
         ``notch_spacing``, ``bend_spacing``, ``arcs``, ...) go over it.
     findings : iterable of patterns.Finding
         A pattern's check findings: each piece takes those about its panel.
+    unit : patterns.Unit or str
+        The unit its seam labels say (the drawing's; default mm): each piece made here keeps its labels,
+        placed once for it (``Piece.labels``).
 
     Returns
     -------
@@ -107,7 +111,7 @@ def pieces_of(source, options: PieceOptions | None = None, *, findings: Iterable
         for p in ps:
             p = replace(p, name=f"{printable(part)}/{p.name}") if several and prefix else p
             if made:  # its labels placed once, here, and kept: the notes and every writer read them
-                p = with_labels(p)
+                p = with_labels(p, unit)
                 p = replace(p, findings=tuple(p.findings) + label_findings(p))
             out.append(p)
     return tuple(out)

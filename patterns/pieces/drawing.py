@@ -19,6 +19,7 @@ import numpy as np
 from ..curves import Motion
 from ..findings import Finding
 from ..pattern import Pattern
+from ..units import Unit
 from .build import pieces_of
 from .options import PieceOptions
 
@@ -110,7 +111,7 @@ def place_nest(pieces, stock, *, margin: float = MARGIN) -> tuple:
 
 
 def drawing_of(source, options: PieceOptions | None = None, *, findings: tuple[Finding, ...] = (),
-               **keywords) -> Drawing:
+               unit: Unit | str = Unit.MM, **keywords) -> Drawing:
     """The drawing of a pattern, a blank, pieces or a list of them: their pieces laid in rows (a pattern
     already laid out, :meth:`patterns.Pattern.placed`, keeps its layout).
 
@@ -122,11 +123,13 @@ def drawing_of(source, options: PieceOptions | None = None, *, findings: tuple[F
         Keywords (any :class:`PieceOptions` field) go over it; ``gap`` is the space between pieces.
     findings : tuple of patterns.Finding
         A pattern's check findings, for its pieces.
+    unit : patterns.Unit or str
+        The unit the pieces' seam labels say (the file's: default mm); their labels are placed once, for it.
     """
     if isinstance(source, Drawing):
         return source
     opts = PieceOptions.of(options, keywords)
-    pieces = pieces_of(source, opts, findings=findings)
+    pieces = pieces_of(source, opts, findings=findings, unit=unit)
     items = list(source) if isinstance(source, (list, tuple)) else [source]
     name = " + ".join(dict.fromkeys(str(getattr(item, "name", "")) for item in items)) or "pieces"
     laid_out = isinstance(source, Pattern) and source.laid_out

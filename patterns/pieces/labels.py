@@ -13,13 +13,13 @@ than shrunk or drawn across a cut, and :func:`label_findings` says so (a
 metrics of the standard style, 10 % wider for readers with wider fonts.
 
 A piece's labels are placed once, when :func:`~patterns.pieces.pieces_of` makes
-it (:func:`place_labels`), in mm, and kept on the piece (``Piece.labels``), moved
-with it by the layout and the nester; the notes, the DXF, SVG and JSON writers
-and the worker all read those.  A seam label's place is reserved for its text
-in the widest of the units (``S1 3D 12.3456 FLAT 12.3456 cm``), so that a writer
-in any unit only rewrites its text (:func:`piece_labels`).  ASTM's title block
-(the standard's annotation lines) is its own: it alone is placed by that
-writer, clear of the piece's other labels.
+it (:func:`place_labels`), for the unit its seam labels say (the drawing's: mm
+unless a machine DXF in another unit is made), and kept on the piece
+(``Piece.labels``), moved with it by the layout and the nester; the notes, the
+DXF, SVG and JSON writers and the worker all read those (:func:`piece_labels`).
+Only a writer in another unit than the one the piece was labelled for places
+them anew.  ASTM's title block (the standard's annotation lines) is its own: it
+alone is placed by that writer, clear of the piece's other labels.
 """
 
 from __future__ import annotations
@@ -244,13 +244,10 @@ def _place_all(piece: Piece, unit: Unit, block, *, title_first: bool) -> LabelPl
         _title(placer, piece, block, angles)
     for k, side in enumerate(piece.seams):
         text = seam_text(side, unit)
-        wide = _widest(side)  # its place is reserved for its text in any unit: a writer only rewrites it
         h = max(0.6 * th, placer.least)
         tries = along(side.points, 1.6 * h)
-        if any(placer.place(wide, [place], h, readable_angle(tangent), kind="seam", of=k, note=False)
-               for place, tangent in tries):
-            placer.labels[-1] = replace(placer.labels[-1], text=text)
-        else:
+        if not any(placer.place(text, [place], h, readable_angle(tangent), kind="seam", of=k, note=False)
+                   for place, tangent in tries):
             placer.left_out.append(Label(text, tries[0][0], h, readable_angle(tries[0][1]), "seam", k))
     for k, bend in enumerate(piece.bends):
         a, b = bend.line
@@ -276,43 +273,44 @@ def _place_all(piece: Piece, unit: Unit, block, *, title_first: bool) -> LabelPl
     return placer
 
 
-def _widest(side: SeamSide) -> str:
-    """The seam label's text in the unit that writes it widest (its place is kept for that one)."""
-    return max((seam_text(side, unit) for unit in Unit), key=lambda t: text_width(t, 1.0))
-
-
-def place_labels(piece: Piece) -> Labels:
-    """Every label of a piece placed clear of the others inside the finished piece, in mm, none below the least
+def place_labels(piece: Piece, unit: Unit = Unit.MM) -> Labels:
+    """Every label of a piece placed clear of the others inside the finished piece (mm), none below the least
     height (:func:`least_height`), and those that fit nowhere: what ``Piece.labels`` keeps.
 
     The title block (the piece's name at 1.2 text heights and the first line of its title at 0.7; level, or
     along a narrow piece's length where it fits only so), then one label per seam side (``"seam"``, 0.6 text
-    heights, along the seam and 1.6 label heights inside it, its middle first, its place kept for its text in
-    any unit), then one per bend line (``"bend"``, half a text height, centred on the line, or across it beside
-    its middle when the line is too short; a blank's bends numbered in the bending order).
+    heights, along the seam and 1.6 label heights inside it, its middle first, its lengths in ``unit``), then
+    one per bend line (``"bend"``, half a text height, centred on the line, or across it beside its middle
+    when the line is too short; a blank's bends numbered in the bending order).
     """
-    placer = _placer(piece, Unit.MM, None)
-    return Labels(tuple(placer.labels), tuple(placer.left_out), placer.least)
+    placer = _placer(piece, Unit(unit), None)
+    return Labels(tuple(placer.labels), tuple(placer.left_out), placer.least, Unit(unit).value)
 
 
-def labels_of(piece: Piece) -> Labels:
-    """The piece's labels: those it keeps (``Piece.labels``), or, for a piece made without, placed now."""
-    return piece.labels if piece.labels is not None else place_labels(piece)
+def labels_of(piece: Piece, unit: Unit | str | None = None) -> Labels:
+    """The piece's labels for ``unit``: those it keeps (``Piece.labels``) when they are for that unit (or
+    ``unit`` is None), else placed now (a piece made without, or a writer in another unit)."""
+    kept = piece.labels
+    if kept is not None and (unit is None or kept.unit == Unit(unit).value):
+        return kept
+    return place_labels(piece, Unit.MM if unit is None else Unit(unit))
 
 
-def with_labels(piece: Piece) -> Piece:
-    """The piece with its labels placed and kept (itself when it has them)."""
-    return piece if piece.labels is not None else replace(piece, labels=place_labels(piece))
+def with_labels(piece: Piece, unit: Unit | str = Unit.MM) -> Piece:
+    """The piece with its labels for ``unit`` placed and kept (itself when it has them)."""
+    if piece.labels is not None and piece.labels.unit == Unit(unit).value:
+        return piece
+    return replace(piece, labels=place_labels(piece, Unit(unit)))
 
 
-def piece_labels(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> list:
-    """Every label of a piece as a writer in ``unit`` draws it: its kept labels (:func:`labels_of`), a seam's
-    text in ``unit``; places in mm.
+def piece_labels(piece: Piece, unit: Unit | str | None = None, *, block=None) -> list:
+    """Every label of a piece as a writer in ``unit`` draws it (places in mm): those the piece keeps
+    (:func:`labels_of`; ``unit`` None: in the unit it was labelled for).
 
     Parameters
     ----------
     piece : Piece
-    unit : patterns.Unit
+    unit : patterns.Unit or str, optional
         The drawing's unit (the seam labels say it).
     block : list of (str, float, float), optional
         Another title block (ASTM's annotation lines), as :meth:`LabelPlacer.place_block` takes it: placed
@@ -324,20 +322,15 @@ def piece_labels(piece: Piece, unit: Unit = Unit.MM, *, block=None) -> list:
         The title block (kind ``"title"``), then the seam labels (``"seam"``), then the bend labels
         (``"bend"``); those that fit nowhere are left out (:func:`label_findings`).
     """
-    kept = labels_of(piece)
-    out = [replace(label, text=seam_text(piece.seams[label.of], unit)) if label.kind == "seam" and unit is not Unit.MM
-           else label for label in kept.placed]
+    kept = labels_of(piece, unit)
     if block is None:
-        return out
+        return list(kept.placed)
     placer = LabelPlacer(piece.finished, kept.least)
-    others = [label for label in out if label.kind != "title"]
-    placer.boxes = [text_box(_widest(piece.seams[label.of]) if label.kind == "seam" else label.text, label.at,
-                             label.height, label.angle) for label in others]
+    others = [label for label in kept.placed if label.kind != "title"]
+    placer.boxes = [text_box(label.text, label.at, label.height, label.angle) for label in others]
     turned = _long_axis(piece.finished)
     _title(placer, piece, block, (0.0,) if abs(turned) < 1e-6 else (0.0, turned))
     return placer.labels + others
-
-
 def label_findings(piece: Piece) -> tuple:
     """One ``label-left-out`` note per label of ``piece`` that fits nowhere on it at the least text height
     (the writers leave it out): which label, on which piece, and where it was wanted."""

@@ -230,15 +230,18 @@ class Labels:
         ``label-left-out`` note on the piece).
     least : float
         The least height any label was tried at, mm.
+    unit : str
+        The unit the seam labels say their lengths in (``"mm"``, ...; places are in mm).
     """
 
     placed: tuple
     left_out: tuple
     least: float
+    unit: str = "mm"
 
     def moved(self, motion: Motion) -> Labels:
         return Labels(tuple(label.moved(motion) for label in self.placed),
-                      tuple(label.moved(motion) for label in self.left_out), self.least)
+                      tuple(label.moved(motion) for label in self.left_out), self.least, self.unit)
 
 
 @dataclass(frozen=True)
