@@ -68,6 +68,7 @@ from ..mesh import edge_lengths, polyline_length, unique_edges
 from ..pattern import Dart, DartSearch, Flattening
 from .curvature import crown_of, gore_bound
 from .engine import flatten_mesh
+from .remedy import Darted
 from .seams import seam_edges
 
 __all__ = ["DartLine", "cut_darts", "dart_lines"]
@@ -100,7 +101,7 @@ class DartLine:
     reach: float
 
 
-def cut_darts(result: Flattening, limit: float, max_darts: int, held, options: dict):
+def cut_darts(result: Flattening, limit: float, max_darts: int, held, options: dict) -> Darted:
     """Cut darts into a flattening until its worst triangle strain is within ``limit``.
 
     Parameters
@@ -119,7 +120,7 @@ def cut_darts(result: Flattening, limit: float, max_darts: int, held, options: d
 
     Returns
     -------
-    (Flattening, tuple of Dart, DartSearch or None)
+    Darted
         The result unchanged and no dart when it is within the limit already
         or no dart helps; otherwise the darted flattening (the mesh with the
         dart lines put in and cut) and its darts.  Where the limit is not met
@@ -128,13 +129,13 @@ def cut_darts(result: Flattening, limit: float, max_darts: int, held, options: d
     """
     first = worst_strain(result)
     if max_darts < 1:
-        return result, (), None  # no dart asked for: nothing looked for
+        return Darted(result, (), None)  # no dart asked for: nothing looked for
     if first <= limit:
-        return result, (), DartSearch(limit, max_darts, first, first, True, True, (), 0.0)
+        return Darted(result, (), DartSearch(limit, max_darts, first, first, True, True, (), 0.0))
     tries = []
     plan = _Plan(result, limit, held, options)
     if plan.bound == 0:  # no positive curvature for a dart to take out (a saddle): none is cut
-        return result, (), DartSearch(limit, max_darts, first, first, False, True, (), 0.0)
+        return Darted(result, (), DartSearch(limit, max_darts, first, first, False, True, (), 0.0))
     # A panel sewn to others (seams held: a gore of a cup) is tried evenly first, its darts run towards
     # the corner where its seams meet; a panel on its own from its curvature first.  The other search
     # follows where the first falls short (the even one not where more darts are asked for than allowed).
@@ -153,16 +154,16 @@ def cut_darts(result: Flattening, limit: float, max_darts: int, held, options: d
 
     if found is not None:
         sewn, darts = found
-        return sewn, darts, search(worst_strain(sewn), True)
+        return Darted(sewn, darts, search(worst_strain(sewn), True))
     _, flat, darts = best
     if not darts:
-        return result, (), search(first, False)
+        return Darted(result, (), search(first, False))
     sewn = _sewn(flat, darts, held, options)
     out = sewn if _kept(sewn) else flat
     reached = worst_strain(out)
     if reached >= first:  # sewn, the closest try is no better than no dart at all: none is cut
-        return result, (), search(first, False)
-    return out, darts, search(reached, reached <= limit, out is sewn)
+        return Darted(result, (), search(first, False))
+    return Darted(out, darts, search(reached, reached <= limit, out is sewn))
 
 
 def _first_sewn(passing, limit, held, options):

@@ -23,7 +23,8 @@ from ..pattern import Flattening
 from .curvature import gore_bound
 from .darts import dart_lines, worst_strain
 from .inserts import relieved
-from .split import FlatPiece, split_panel
+from .remedy import FlatPiece, Remedy
+from .split import split_panel
 
 __all__ = ["gore_paths", "gore_search", "gored"]
 
@@ -38,12 +39,12 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
     if worst_strain(result) <= limit:
         return model
     found = gore_search(model, index, result, limit, max_cuts, flat, max_slashes=max_slashes)
-    return model if found is None else found[1]
+    return model if found is None else found.model
 
 
 def gore_search(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, flat: FlatPiece, *,
-                max_slashes: int = 0):
-    """``(worst gore's strain, split model)``: panel ``index`` split into the fewest gores within ``limit``.
+                max_slashes: int = 0) -> Remedy | None:
+    """Panel ``index`` split into the fewest gores within ``limit`` (the worst gore's strain, the model).
 
     Parameters
     ----------
@@ -58,8 +59,8 @@ def gore_search(model: Model, index: int, result: Flattening, limit: float, max_
         At most this many cuts (as many pieces round a crown inside the
         panel, one more to a crown on its outline).
     flat : callable
-        ``flat(model, p) -> (Flattening, held, options)``: a gore flattened as
-        :func:`patterns.flatten` flattens it (:data:`patterns.flattening.split.FlatPiece`).
+        ``flat(model, p) -> PanelFlat``: a gore flattened as :func:`patterns.flatten` flattens it
+        (:data:`patterns.flattening.remedy.FlatPiece`).
     max_slashes : int
         A gore above the limit that is saddle-shaped (a seat's waist) is
         slashed and given inserts, at most this many slashes
@@ -67,14 +68,14 @@ def gore_search(model: Model, index: int, result: Flattening, limit: float, max_
 
     Returns
     -------
-    (float, Model) or None
+    Remedy or None
         None if no split with 1 to ``max_cuts`` cuts could be made; otherwise
         the split that meets the limit with the fewest cuts tried, or, if none
         does, the one that came closest, and its worst gore's strain.  The counts tried start at the gore bound
         (:func:`patterns.flattening.curvature.gore_bound`, rounded up) and go
         up until the limit is met, or down from there while it still is.
     """
-    tried = {}  # cuts -> (worst piece's strain, split model), or None where the split could not be made
+    tried = {}  # cuts -> Remedy (no darts), or None where the split could not be made
 
     def attempt(k: int):
         if k not in tried:
@@ -83,12 +84,12 @@ def gore_search(model: Model, index: int, result: Flattening, limit: float, max_
             split = None if paths is None else split_panel(model, index, paths)
             if split is not None:
                 n_pieces = len(split.panels) - len(model.panels) + 1
-                worst, split, _ = relieved(split, index, n_pieces, limit, flat, max_slashes=max_slashes)
-                tried[k] = (worst, split)
+                found = relieved(split, index, n_pieces, limit, flat, max_slashes=max_slashes)
+                tried[k] = Remedy(found.worst, found.model)
         return tried[k]
 
     def met(k: int) -> bool:
-        return attempt(k) is not None and tried[k][0] <= limit
+        return attempt(k) is not None and tried[k].worst <= limit
 
     # From the gore bound (what the curvature asks for, balanced gores): up until the limit is met,
     # or, if met there at once, down while it still is.
@@ -100,10 +101,10 @@ def gore_search(model: Model, index: int, result: Flattening, limit: float, max_
         while k < max_cuts and not met(k + 1):
             k += 1
     done = {c: v for c, v in tried.items() if v is not None}
-    passing = [c for c, v in done.items() if v[0] <= limit]
+    passing = [c for c, v in done.items() if v.worst <= limit]
     if passing:
         return done[min(passing)]
-    return min(done.values(), key=lambda v: v[0]) if done else None
+    return min(done.values(), key=lambda v: v.worst) if done else None
 
 
 def gore_paths(result: Flattening, k: int, limit: float):

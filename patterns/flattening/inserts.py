@@ -45,7 +45,8 @@ from ..model import Model
 from ..pattern import Flattening
 from .curvature import crown_of, gore_bound
 from .darts import cut_darts, worst_strain
-from .split import FlatPiece, flat_piece, split_panel
+from .remedy import FlatPiece, Remedy
+from .split import flat_piece, split_panel
 
 __all__ = ["is_saddle", "relieved", "slash_search", "slashed"]
 
@@ -93,12 +94,13 @@ def slashed(model: Model, index: int, result: Flattening, limit: float, max_slas
         piece within the limit, or, if none does, the try that came closest.
     """
     found = slash_search(model, index, result, limit, max_slashes, options)
-    return model if found is None else found[1]
+    return model if found is None else found.model
 
 
-def slash_search(model: Model, index: int, result: Flattening, limit: float, max_slashes: int, options: dict):
-    """``(worst piece's strain, model)``: what :func:`slashed` found, or None where it leaves the model unchanged
-    (the panel within the limit or not saddle-shaped)."""
+def slash_search(model: Model, index: int, result: Flattening, limit: float, max_slashes: int,
+                 options: dict) -> Remedy | None:
+    """What :func:`slashed` found (the worst piece's strain, the model), or None where it leaves the model
+    unchanged (the panel within the limit or not saddle-shaped)."""
     before = worst_strain(result)
     if before <= limit:
         return None
@@ -107,34 +109,34 @@ def slash_search(model: Model, index: int, result: Flattening, limit: float, max
         return None
     first = int(np.clip(np.ceil(gore_bound(result, limit, defects=-defects)), 1, max_slashes))
     outline = _Outline(result, np.maximum(-defects, 0.0))
-    best = (before, model)
+    best = Remedy(before, model)
     for k in range(first, max_slashes + 1):
-        worst, split = _slashed(model, index, outline, k, limit, options)
-        if worst < best[0]:
-            best = (worst, split)
-        if worst > limit:
+        tried = _slashed(model, index, outline, k, limit, options)
+        if tried.worst < best.worst:
+            best = tried
+        if tried.worst > limit:
             continue
         for fewer in range(k - 1, 0, -1):  # met at once: as few as meet
-            worst, split = _slashed(model, index, outline, fewer, limit, options)
-            if worst > limit:
+            tried = _slashed(model, index, outline, fewer, limit, options)
+            if tried.worst > limit:
                 break
-            best = (worst, split)
+            best = tried
         break
     return best
 
 
-def _slashed(model, index, outline, k, limit, options) -> tuple:
-    """``(worst strain of the pieces, model)`` of the first of :data:`_TRIES` that meets ``limit`` with ``k``
-    slashes, or the closest; ``(inf, model)`` if none could be cut."""
-    best = (np.inf, model)
+def _slashed(model, index, outline, k, limit, options) -> Remedy:
+    """The first of :data:`_TRIES` that meets ``limit`` with ``k`` slashes, or the closest; the model as it was,
+    at an infinite strain, if none could be cut."""
+    best = Remedy(np.inf, model)
     for depth, spread in _TRIES:
         paths = outline.wedge_paths(k, depth, spread)
         split = None if paths is None else split_panel(model, index, paths, inserts=True)
         if split is None or len(split.panels) != len(model.panels) + k:
             continue
         worst = max(worst_strain(flat_piece(split, p, options)) for p in range(index, index + k + 1))
-        if worst < best[0]:
-            best = (worst, split)
+        if worst < best.worst:
+            best = Remedy(worst, split)
         if worst <= limit:
             break
     return best
@@ -186,7 +188,7 @@ class _Outline:
 
 
 def relieved(model: Model, first: int, count: int, limit: float, flat: FlatPiece, *, max_slashes: int,
-             max_darts: int | None = None) -> tuple:
+             max_darts: int | None = None) -> Remedy:
     """Pieces just split from one panel, each brought towards ``limit``: slashed where saddle-shaped, else darted.
 
     Parameters
@@ -198,9 +200,8 @@ def relieved(model: Model, first: int, count: int, limit: float, flat: FlatPiece
     limit : float
         The largest principal strain allowed.
     flat : callable
-        ``flat(model, p) -> (Flattening, held, options)``: panel ``p`` flattened
-        as :func:`patterns.flatten` flattens it, its held seam lengths and the
-        keywords of :func:`flatten_mesh`.
+        ``flat(model, p) -> PanelFlat``: panel ``p`` flattened as
+        :func:`patterns.flatten` flattens it.
     max_slashes : int
         A piece above the limit that is saddle-shaped (:func:`is_saddle`) is
         slashed and given inserts (:func:`slash_search`), at most this many.
@@ -210,23 +211,23 @@ def relieved(model: Model, first: int, count: int, limit: float, flat: FlatPiece
 
     Returns
     -------
-    (float, Model, dict)
+    Remedy
         The worst strain of all the pieces (inserts included), the model with
-        the inserts, and ``{piece name: (Flattening, darts, DartSearch)}`` of
-        the pieces darted (where ``max_darts`` is given).
+        the inserts, and the pieces darted (where ``max_darts`` is given).
     """
     darted, worst = {}, 0.0
     for p in reversed(range(first, first + count)):  # an insert moves the pieces after its panel, not those before
-        piece, held, options = flat(model, p)
+        start = flat(model, p)
+        piece = start.flattening
         panel = model.panels[p]
         if worst_strain(piece) > limit and max_slashes > 0 and is_saddle(panel.vertices, panel.faces, panel.loops):
-            found = slash_search(model, p, piece, limit, max_slashes, options)
+            found = slash_search(model, p, piece, limit, max_slashes, start.options)
             if found is not None:
-                worst, model = max(worst, found[0]), found[1]
+                worst, model = max(worst, found.worst), found.model
                 continue
         if max_darts is not None:
-            darted[panel.name] = cut_darts(piece, limit, max_darts, held, options)
-            piece = darted[panel.name][0]
+            darted[panel.name] = cut_darts(piece, limit, max_darts, start.held, start.options)
+            piece = darted[panel.name].flattening
         worst = max(worst, worst_strain(piece))
-    return worst, model, darted
+    return Remedy(worst, model, darted)
 

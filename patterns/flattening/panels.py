@@ -22,9 +22,9 @@ from .gores import gore_search, gored
 from .grain import grain_table, turn_to_grain
 from .inserts import is_saddle, slashed
 from .parted import darts_needed, parted
+from .remedy import FlatPiece, PanelFlat, Remedy
 from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
 from .settings import FlattenOptions
-from .split import FlatPiece
 
 __all__ = ["flatten"]
 
@@ -103,7 +103,7 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     grain_table(opts.grain, model)  # bad grain or ease refused before any long work
     eased = validate_ease(opts.ease, model)
     mode = SeamLengths(opts.seams)
-    darted = {}  # panel name -> (Flattening, darts, DartSearch): darted while the panels were split
+    darted = {}  # panel name -> Darted: darted while the panels were split
     if max_strain is not None:
         keep = {model.seams[s].panels[side] for s, side in eased}  # an eased seam's panel keeps its name
         model, darted = _split(model, opts, offset, keep)
@@ -117,11 +117,14 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
         if opts.exact and panel.surface is not None and i not in eased_panels:
             result = developed(panel, offset, f"{model.name}: panel {panel.name}")
         elif panel.name in darted:
-            result, darts, search = darted[panel.name]
+            got = darted[panel.name]
+            result, darts, search = got.flattening, got.darts, got.search
         else:
-            result, held, options = _flat_panel(model, i, opts, offset, eased)
+            start = _flat_panel(model, i, opts, offset, eased)
+            result = start.flattening
             if max_strain is not None and not opts.gores and panel.name not in no_darts:  # slashed, or an insert
-                result, darts, search = cut_darts(result, max_strain, max_darts, held, options)
+                got = cut_darts(result, max_strain, max_darts, start.held, start.options)
+                result, darts, search = got.flattening, got.darts, got.search
         targets.update(_side_targets(model, i, result, eased, mode))
         if panel.name in grains:
             result = turn_to_grain(result, grains[panel.name])
@@ -145,16 +148,16 @@ def _engine_options(opts: FlattenOptions, name: str) -> dict:
             "min_stretch": opts.min_stretch, "energy": opts.energy, "name": name}
 
 
-def _flat_panel(model: Model, i: int, opts: FlattenOptions, offset: float, eased) -> tuple:
-    """``(Flattening, held, options)``: panel ``i`` by the mesh engine (its neutral surface where ``offset``), its
-    seams held as ``opts.seams`` says (with the ``eased`` sides' ease), and the keywords of :func:`flatten_mesh`."""
+def _flat_panel(model: Model, i: int, opts: FlattenOptions, offset: float, eased) -> PanelFlat:
+    """Panel ``i`` by the mesh engine (its neutral surface where ``offset``), its seams held as ``opts.seams``
+    says (with the ``eased`` sides' ease), and the keywords of :func:`flatten_mesh` it was flattened with."""
     panel = model.panels[i]
     vertices = offset_along_normals(panel, offset) if offset else panel.vertices
     held = None
     if opts.method == "relaxed":
         held = held_lengths(model, i, vertices, eased, SeamLengths(opts.seams), mesh_edges=unique_edges(panel.faces))
     options = _engine_options(opts, f"{model.name}: panel {panel.name}")
-    return flatten_mesh(vertices, panel.faces, lengths=held, **options), held, options
+    return PanelFlat(flatten_mesh(vertices, panel.faces, lengths=held, **options), held, options)
 
 
 def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> tuple:
@@ -164,9 +167,9 @@ def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> tupl
 
     Panels are taken last to first, so that a split does not move the
     panels still to be looked at.  Returns the model and ``{panel name:
-    (Flattening, darts, DartSearch)}`` of the panels darted here.
+    Darted}`` of the panels darted here.
     """
-    def flat(m: Model, p: int) -> tuple:  # a piece of a split panel, flattened as the panels are
+    def flat(m: Model, p: int) -> PanelFlat:  # a piece of a split panel, flattened as the panels are
         return _flat_panel(m, p, opts, offset, {})
 
     darted = {}
@@ -177,45 +180,45 @@ def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> tupl
         saddle = is_saddle(panel.vertices, panel.faces, panel.loops)
         if not (opts.gores or saddle or opts.max_gores):
             continue
-        result, held, options = _flat_panel(model, i, opts, offset, {})
+        start = _flat_panel(model, i, opts, offset, {})
         if opts.gores:
-            model = gored(model, i, result, opts.max_strain, opts.max_gores, flat, max_slashes=opts.max_darts)
+            model = gored(model, i, start.flattening, opts.max_strain, opts.max_gores, flat, max_slashes=opts.max_darts)
         elif saddle:
-            model = slashed(model, i, result, opts.max_strain, opts.max_darts, options)
+            model = slashed(model, i, start.flattening, opts.max_strain, opts.max_darts, start.options)
         else:
-            model, got = _darted(model, i, (result, held, options), opts, flat)
-            darted.update(got)
+            remedy = _darted(model, i, start, opts, flat)
+            model = remedy.model
+            darted.update(remedy.darted)
     return model, darted
 
 
-def _darted(model: Model, i: int, start: tuple, opts: FlattenOptions, flat: FlatPiece) -> tuple:
-    """``(model, {panel name: (Flattening, darts, DartSearch)})``: panel ``i`` (``start`` = its dartless
-    ``(Flattening, held, options)``; ``flat`` flattens a piece) darted whole, or, where darts alone fall short of the limit, parted into
-    pieces with darts (:func:`.parted.parted`), or else cut into dartless gores (:func:`.gores.gore_search`):
-    the first that meets the limit, or the one that came closest."""
-    result, held, options = start
+def _darted(model: Model, i: int, start: PanelFlat, opts: FlattenOptions, flat: FlatPiece) -> Remedy:
+    """Panel ``i`` (``start``: it flattened without darts; ``flat`` flattens a piece) darted whole, or, where
+    darts alone fall short of the limit, parted into pieces with darts (:func:`.parted.parted`), or else cut
+    into dartless gores (:func:`.gores.gore_search`): the first that meets the limit, or the one that came
+    closest (on a tie, the one tried first: whole, parted, gores)."""
+    result = start.flattening
     limit, max_darts, name = opts.max_strain, opts.max_darts, model.panels[i].name
     whole = None
     if worst_strain(result) <= limit or darts_needed(result, limit) <= max_darts:
-        whole = cut_darts(result, limit, max_darts, held, options)
-        if worst_strain(whole[0]) <= limit:
-            return model, {name: whole}
-    tries = []  # (worst strain, model, darted panels), in the order preferred on a tie
+        whole = cut_darts(result, limit, max_darts, start.held, start.options)
+        if worst_strain(whole.flattening) <= limit:
+            return Remedy(worst_strain(whole.flattening), model, {name: whole})
+    tries = []  # in the order preferred on a tie
     pieces = parted(model, i, result, limit, max_darts, opts.max_gores, flat)
     if pieces is not None:
         tries.append(pieces)
-        if pieces[0] <= limit:
-            return pieces[1], pieces[2]
+        if pieces.worst <= limit:
+            return pieces
     gores = gore_search(model, i, result, limit, opts.max_gores, flat, max_slashes=max_darts)
     if gores is not None:
-        tries.append((gores[0], gores[1], {}))
-        if gores[0] <= limit:
-            return gores[1], {}
+        tries.append(gores)
+        if gores.worst <= limit:
+            return gores
     if whole is None:
-        whole = cut_darts(result, limit, max_darts, held, options)
-    tries.insert(0, (worst_strain(whole[0]), model, {name: whole}))
-    _, closest, got = min(tries, key=lambda t: t[0])
-    return closest, got
+        whole = cut_darts(result, limit, max_darts, start.held, start.options)
+    tries.insert(0, Remedy(worst_strain(whole.flattening), model, {name: whole}))
+    return min(tries, key=lambda t: t.worst)
 
 
 def _flat_length(flat: FlatPanel, edges: np.ndarray, idx, seam) -> float:

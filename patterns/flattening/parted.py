@@ -40,7 +40,8 @@ from ..pattern import Flattening
 from .curvature import gore_bound
 from .gores import gore_paths
 from .inserts import relieved
-from .split import FlatPiece, split_panel
+from .remedy import FlatPiece, Remedy
+from .split import split_panel
 
 __all__ = ["darts_needed", "parted"]
 
@@ -55,7 +56,7 @@ def darts_needed(result: Flattening, limit: float) -> float:
 
 
 def parted(model: Model, index: int, result: Flattening, limit: float, max_darts: int, max_pieces: int,
-           flat: FlatPiece):
+           flat: FlatPiece) -> Remedy | None:
     """Panel ``index`` parted into the fewest pieces tried that each come within ``limit`` with darts.
 
     Parameters
@@ -72,16 +73,14 @@ def parted(model: Model, index: int, result: Flattening, limit: float, max_darts
     max_pieces : int
         At most this many cuts (``max_gores``).
     flat : callable
-        ``flat(model, p) -> (Flattening, held, options)``: panel ``p`` of a
-        model flattened as :func:`patterns.flatten` flattens it, its held seam
-        lengths and the keywords of :func:`flatten_mesh`.
+        ``flat(model, p) -> PanelFlat``: panel ``p`` of a model flattened as
+        :func:`patterns.flatten` flattens it.
 
     Returns
     -------
-    (float, Model, dict) or None
-        The worst piece's strain, the parted model and ``{piece name: (Flattening,
-        darts, DartSearch)}``: the first count tried that meets the limit, or
-        the one that came closest; None where no count could be cut.
+    Remedy or None
+        The worst piece's strain, the parted model and its pieces darted: the first count tried that meets the
+        limit, or the one that came closest; None where no count could be cut.
     """
     first = max(3, int(np.ceil(gore_bound(result, limit) / _PIECE_BOUND)))
     best = None
@@ -90,11 +89,11 @@ def parted(model: Model, index: int, result: Flattening, limit: float, max_darts
         split = None if paths is None else split_panel(model, index, paths)
         if split is None:
             continue
-        worst, split, darted = relieved(split, index, len(split.panels) - len(model.panels) + 1, limit, flat,
-                                        max_slashes=max_darts, max_darts=max_darts)
-        if best is None or worst < best[0]:
-            best = (worst, split, darted)
-        if worst <= limit:
+        found = relieved(split, index, len(split.panels) - len(model.panels) + 1, limit, flat,
+                         max_slashes=max_darts, max_darts=max_darts)
+        if best is None or found.worst < best.worst:
+            best = found
+        if found.worst <= limit:
             break
     return best
 

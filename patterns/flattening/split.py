@@ -9,8 +9,6 @@ cut starts inside is parted with it, one seam a piece.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from ..cut import cut_along, pieces
@@ -20,11 +18,7 @@ from ..pattern import Flattening
 from .engine import flatten_mesh
 from .seams import held_lengths
 
-__all__ = ["FlatPiece", "flat_piece", "split_panel"]
-
-FlatPiece = Callable[[Model, int], tuple]
-"""``flat(model, p) -> (Flattening, held, options)``: panel ``p`` of a model flattened as
-:func:`patterns.flatten` flattens it, its held seam lengths and the keywords of :func:`flatten_mesh`."""
+__all__ = ["flat_piece", "split_panel"]
 
 
 def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Model | None:
