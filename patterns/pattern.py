@@ -434,6 +434,11 @@ class Pattern:
         The strain limit the pattern was flattened to (``flatten(max_strain=...)``,
         which cut darts to meet it): :func:`patterns.check` judges against it
         unless told another limit.
+    thickness, k_factor, reference
+        The sheet the panels were developed for (``flatten(thickness=...)``: each panel's
+        neutral surface), as given; 0 thickness: the surface itself.
+    laid_out : bool
+        The panels have been placed on a sheet (:meth:`placed`).
     """
 
     model: Model

@@ -200,3 +200,18 @@ def test_report_to_json_warns_and_writes_the_report(duct, tmp_path):
     with pytest.warns(DeprecationWarning, match=_DEPRECATED):
         report.to_json(tmp_path / "report.json")
     assert json.loads((tmp_path / "report.json").read_text()) == json.loads(json.dumps(report.to_dict()))
+
+
+def test_piece_options_largest_allowance_warns_and_works():
+    with pytest.warns(DeprecationWarning, match=_DEPRECATED):
+        assert patterns.PieceOptions(seam_allowance={"front": 4.0, "back": 12.5}).largest_allowance == 12.5
+    with pytest.warns(DeprecationWarning, match=_DEPRECATED):
+        assert patterns.PieceOptions(seam_allowance=6.0).largest_allowance == 6.0
+
+
+def test_the_service_records_of_warns_and_gives_the_bundles_records():
+    from patterns.service import records_of
+
+    with pytest.warns(DeprecationWarning, match=r"records_of goes in 0.3.0"):
+        records = records_of("pattern", {"dart_strain": 0.03}, name="x")
+    assert records[patterns.FlattenOptions].max_strain == 0.03 and records[patterns.CheckOptions].max_strain is None

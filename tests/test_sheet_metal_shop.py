@@ -308,7 +308,7 @@ def test_convex_conical_bend_takes_its_neutral_layer_from_the_inside(tmp_path):
 @pytest.mark.slow
 def test_convex_meshed_bend_takes_its_neutral_layer_from_the_inside():
     """Planted bug caught: the meshed face's neutral surface moved K t into the sheet from a convex skin
-    instead of (1 - K) t (meshed.mesh_face).  The spline bend unfolded from either skin, K = 0.3, and with mild
+    instead of (1 - K) t (meshed.meshed_face).  The spline bend unfolded from either skin, K = 0.3, and with mild
     steel (r/t 1.33: K 0.43): 100 + pi/2 (r + K t) long (the mesh's chords: within 0.05 mm)."""
     part = spline_strip()
     skins = [i for i, f in enumerate(part.faces()) if f.geom_type.name == "PLANE" and abs(f.area - 60 * 30) < 1e-6]

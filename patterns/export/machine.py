@@ -22,11 +22,7 @@ from .dxfdoc import add_loop, add_polyline, add_text, declare_linetypes, new_doc
 from .layers import LayerMap
 from .options import WriteOptions
 
-__all__ = ["MACHINE_VERSIONS", "write"]
-
-MACHINE_VERSIONS = {"R12": "AC1009", "R2000": "AC1015", "R2004": "AC1018", "R2007": "AC1021",
-                    "R2010": "AC1024", "R2013": "AC1027", "R2018": "AC1032"}
-"""DXF versions the machine profile writes, and their ``$ACADVER``."""
+__all__ = ["write"]
 
 _BEND_ROLE = {"up": "bend_up", "down": "bend_down", "": "bend"}
 

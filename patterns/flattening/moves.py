@@ -20,8 +20,19 @@ from ..measure import signed_areas
 from ..mesh import Connectivity
 from ..predicates import crossing_segments
 
-__all__ = ["align_to_pins", "best_scale", "boundary_crossings", "check_lengths", "check_pins", "edge_index",
-           "edge_rows", "flip_free_steps", "layout_size", "outline_valid", "safe_move"]
+__all__ = [
+    "align_to_pins",
+    "best_scale",
+    "check_lengths",
+    "check_pins",
+    "crossing_vertices",
+    "edge_index",
+    "edge_rows",
+    "flip_free_steps",
+    "layout_size",
+    "outline_valid",
+    "safe_move",
+]
 
 
 def flip_free_steps(uv: np.ndarray, faces: np.ndarray, step: np.ndarray, *, horizon: float = np.inf,
@@ -139,7 +150,7 @@ def safe_move(faces: np.ndarray, loops, uv: np.ndarray, target: np.ndarray, *, t
     for attempt in range(2 * tries):
         cand = uv + alpha[:, None] * step
         bad = ~(signed_areas(cand, faces) > 0)
-        crossing = None if bad.any() else boundary_crossings(cand, loops)
+        crossing = None if bad.any() else crossing_vertices(cand, loops)
         if not bad.any() and crossing is None:
             return cand
         if attempt >= tries:
@@ -158,14 +169,14 @@ def safe_move(faces: np.ndarray, loops, uv: np.ndarray, target: np.ndarray, *, t
 def outline_valid(uv: np.ndarray, loops) -> bool:
     """Whether the flat loops ``uv[loop]`` form a valid polygon (no loop crosses or touches itself or another).
 
-    What a line search needs of :func:`boundary_crossings`, without finding the crossing segments: on
+    What a line search needs of :func:`crossing_vertices`, without finding the crossing segments: on
     libigl's camel, whose legs press together, those took half the relaxation's time.
     """
     rings = [uv[loop] for loop in loops]
     return bool(shapely.is_valid(shapely.Polygon(rings[0], rings[1:])))
 
 
-def boundary_crossings(uv: np.ndarray, loops):
+def crossing_vertices(uv: np.ndarray, loops):
     """None when the flat loops form a valid polygon; else the vertices of the
     boundary segments that cross another one (possibly empty)."""
     if outline_valid(uv, loops):

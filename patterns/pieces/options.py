@@ -81,7 +81,11 @@ class PieceOptions(Options):
 
     @property
     def largest_allowance(self) -> float:
-        """The widest seam allowance asked for, mm."""
+        """Deprecated (goes in 0.3.0; nothing reads it): the widest seam allowance asked for, mm."""
+        import warnings
+
+        warnings.warn("PieceOptions.largest_allowance is deprecated and goes in 0.3.0: use patterns.PieceOptions's "
+                      "seam_allowance (max of its values, for a mapping)", DeprecationWarning, stacklevel=2)
         a = self.seam_allowance
         return max(a.values(), default=0.0) if isinstance(a, Mapping) else float(a)
 

@@ -5,7 +5,7 @@ An unfold is a pipeline of stages over frozen records, like the CAD mesher:
 1. :func:`~patterns.sheetmetal.faces.recognise` -- every face with the
    surface the mesher's recogniser finds (plane, cylinder, cone, or none);
 2. :func:`~patterns.sheetmetal.sheet.find_sheet` -- the fixed face, the
-   thickness and the skin (a :class:`~patterns.sheetmetal.sheet.Sheet`);
+   thickness and the skin (a :class:`~patterns.sheetmetal.sheet.SheetModel`);
 3. :mod:`~patterns.sheetmetal.bends` -- each bend face's curvature, the bends
    (:class:`~patterns.sheetmetal.bends.BendGroup`, developed to their neutral
    width: ``angle (r + K t)`` or a bend table's), and every skin face's exact
@@ -39,7 +39,7 @@ from .faces import recognise, uv_mid
 from .holes import hole_rims
 from .imported import prepared
 from .join import flat, place_faces
-from .meshed import mesh_face
+from .meshed import meshed_face
 from .rules import manufacturability, open_contours
 from .sheet import check_volume, find_sheet
 from .table import BendTable, UnfoldOptions, read_bend_table
@@ -94,7 +94,7 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
     faces = recognise(topology)
     sheet = find_sheet(topology, faces, opts.fixed_face, name)
     curvature = curvatures(faces, sheet, name)
-    meshed = {i: mesh_face(faces[i], sheet.thickness, opts.k_factor if opts.material is None else  # K even with a
+    meshed = {i: meshed_face(faces[i], sheet.thickness, opts.k_factor if opts.material is None else  # K even with a
                            partial(opts.k_factor_at, sheet.thickness, what=f"{name}: face {i}"), name)  # bend table
               for i in sorted(sheet.skin) if faces[i].kind == "other"}
     check_volume(shape, sheet, faces, {i: (c.bend_radius, c.inside_radius) for i, c in curvature.items()}, meshed,

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import InputError
 from .faces import SheetFace, handedness, normal, point, uv_mid
 from .meshed import MeshedFace
-from .sheet import Sheet
+from .sheet import SheetModel
 from .table import UnfoldOptions
 
 __all__ = ["BendGroup", "Curvature", "FaceMap", "curvatures", "face_maps", "group_bends"]
@@ -35,7 +35,7 @@ class Curvature:
     inside_radius: float
 
 
-def curvatures(faces: tuple, sheet: Sheet, name: str) -> dict:
+def curvatures(faces: tuple, sheet: SheetModel, name: str) -> dict:
     """``{face: Curvature}`` of every cylinder and cone of the skin."""
     out = {}
     for i in sorted(sheet.skin):
@@ -102,7 +102,7 @@ def _same_bend(fa: SheetFace, fb: SheetFace) -> bool:
     return abs(abs(fb.axis @ fa.axis) - 1) <= 1e-9 and np.linalg.norm(np.cross(fb.origin - fa.origin, fa.axis)) <= 1e-6
 
 
-def group_bends(faces: tuple, sheet: Sheet, curvature: dict, opts: UnfoldOptions, name: str) -> tuple:
+def group_bends(faces: tuple, sheet: SheetModel, curvature: dict, opts: UnfoldOptions, name: str) -> tuple:
     """The bends of the skin, each developed to its neutral width (cones: see :func:`_cone_bend`)."""
     from OCP.BRepTools import BRepTools
 
@@ -218,7 +218,7 @@ def _cone_map(f: SheetFace, bend: Curvature, thickness: float, k_factor: float) 
     return replace(fmap, mirror=handedness(f, u, v) * float(np.sign(np.linalg.det(jac))))
 
 
-def face_maps(faces: tuple, sheet: Sheet, curvature: dict, bends: tuple, meshed: dict, k_factor: float) -> dict:
+def face_maps(faces: tuple, sheet: SheetModel, curvature: dict, bends: tuple, meshed: dict, k_factor: float) -> dict:
     """``{face: FaceMap}`` of every skin face (a cone's neutral surface at its bend's K-factor, else ``k_factor``)."""
     neutral = {i: b.neutral_radius for b in bends if b.kind == "cylinder" for i in b.faces}
     k_of = {i: b.k_factor for b in bends if b.k_factor is not None for i in b.faces}

@@ -24,7 +24,7 @@ from ..blank import Rim
 from ..curves import Arc, Loop
 from .faces import normal, uv_mid
 from .join import flat
-from .sheet import Sheet
+from .sheet import SheetModel
 
 __all__ = ["RIM", "hole_rims"]
 
@@ -120,7 +120,7 @@ def _rims_of(circles, thickness):
     return through, out
 
 
-def hole_rims(topology, faces: tuple, maps: dict, motions: dict, sheet: Sheet, holes: tuple) -> tuple:
+def hole_rims(topology, faces: tuple, maps: dict, motions: dict, sheet: SheetModel, holes: tuple) -> tuple:
     """The holes to cut at their through diameter, and the countersinks' and counterbores' rims.
 
     Parameters
@@ -131,7 +131,7 @@ def hole_rims(topology, faces: tuple, maps: dict, motions: dict, sheet: Sheet, h
         ``{face: FaceMap}`` of the skin.
     motions : dict
         ``{face: patterns.curves.Motion}``: each skin face's placement on the blank.
-    sheet : Sheet
+    sheet : SheetModel
     holes : tuple of patterns.curves.Loop
         The blank's holes as the developed skin draws them (clockwise).
 

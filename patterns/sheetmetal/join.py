@@ -15,7 +15,7 @@ from ..curves import Motion
 from ..errors import InputError
 from ..tessellate.topology import Topology
 from .faces import edge_uv
-from .sheet import Sheet
+from .sheet import SheetModel
 
 __all__ = ["MEET", "flat", "place_faces"]
 
@@ -33,7 +33,7 @@ def _kabsch(src: np.ndarray, dst: np.ndarray) -> Motion:
     return Motion(angle, float(shift[0]), float(shift[1]))
 
 
-def place_faces(topology: Topology, maps: dict, sheet: Sheet, name: str) -> tuple:
+def place_faces(topology: Topology, maps: dict, sheet: SheetModel, name: str) -> tuple:
     """``({face: Motion}, {meshed face: gap mm})``: each skin face's placement on the blank, breadth first
     from the fixed face, and how far each meshed face's edges land from its neighbours'."""
     motions = {sheet.fixed: Motion()}

@@ -1,7 +1,7 @@
 """A face of a sheet that is no plane, cylinder or cone: meshed, moved to its neutral surface, flattened.
 
 Such a face (a bend drawn as a spline, a freeform dimple) has no exact
-development.  :func:`mesh_face` meshes its skin (well-shaped triangles, half
+development.  :func:`meshed_face` meshes its skin (well-shaped triangles, half
 the thickness across), moves the mesh to the neutral surface (``K t`` into the
 sheet from the concave skin, ``(1 - K) t`` from the convex one) and flattens
 it with the engine; :meth:`MeshedFace.at` maps points of the face to the flat
@@ -23,7 +23,7 @@ from ..pattern import Flattening
 from ..tessellate import mesh_shape
 from .faces import SheetFace, normal, point, uv_mid
 
-__all__ = ["MeshedFace", "mesh_face"]
+__all__ = ["MeshedFace", "meshed_face"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,7 +94,7 @@ def inside_radius(f: SheetFace, thickness: float, concave: bool) -> float:
     return max(1.0 / curvature - (0.0 if concave else thickness), 0.0)
 
 
-def mesh_face(f: SheetFace, thickness: float, k_factor: float | Callable, name: str) -> MeshedFace:
+def meshed_face(f: SheetFace, thickness: float, k_factor: float | Callable, name: str) -> MeshedFace:
     """Mesh and flatten a face that is not developable as a plane, cylinder or cone.
 
     ``k_factor``: the K-factor, or ``k_factor(inside radius mm) -> K`` (a material's), asked at the face's

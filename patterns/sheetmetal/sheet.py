@@ -20,7 +20,7 @@ from ..errors import InputError
 from ..tessellate.topology import Topology
 from .faces import normal, point, uv_mid
 
-__all__ = ["Sheet", "check_volume", "find_sheet"]
+__all__ = ["SheetModel", "check_volume", "find_sheet"]
 
 TANGENT = 1e-4
 """Two faces are tangent along an edge when their normals there differ by less than this (radians, about)."""
@@ -29,8 +29,9 @@ SIDE = 0.4
 
 
 @dataclass(frozen=True, eq=False)
-class Sheet:
-    """The sheet a part is bent from.
+class SheetModel:
+    """The sheet a part is bent from, as read from its solid (a nest's stock sheet is
+    :class:`patterns.nesting.Sheet`).
 
     Attributes
     ----------
@@ -50,7 +51,7 @@ class Sheet:
     neighbours: tuple
 
 
-def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: str) -> Sheet:
+def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: str) -> SheetModel:
     """The sheet: its fixed face, thickness and skin.
 
     The fixed face is ``fixed_face`` when given, else the largest planar face
@@ -82,7 +83,7 @@ def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: s
                 raise InputError(f"{name}: not a sheet: face {fixed} and the faces joined to it smoothly are "
                                  f"{share:.0%} of the part's surface, one side of a sheet nearly half (a block, a "
                                  f"thick plate, the end of a tube)")
-            return Sheet(_thickness(faces, fixed, name), fixed, frozenset(skin), neighbours)
+            return SheetModel(_thickness(faces, fixed, name), fixed, frozenset(skin), neighbours)
         except InputError as exc:
             first = first or exc
     if fixed_face is None and len(planes) > 1:
@@ -189,7 +190,7 @@ def _skin(topology: Topology, tangent: dict, neighbours: tuple, fixed: int, name
     return skin
 
 
-def check_volume(shape, sheet: Sheet, faces, curvature: dict, meshed: dict, name: str) -> None:
+def check_volume(shape, sheet: SheetModel, faces, curvature: dict, meshed: dict, name: str) -> None:
     """InputError unless the solid holds the volume a sheet of this thickness over the skin holds (1 %).
 
     ``curvature`` gives each bend face's ``(bend radius, inside radius)``, ``meshed`` each meshed face's
