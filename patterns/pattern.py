@@ -15,6 +15,7 @@ from functools import cached_property
 import numpy as np
 import shapely
 
+from .curves import Motion
 from .errors import InputError
 from .measure import Distortion, TriangleStrain, distortion, flat_direction, no_strain, triangle_strains
 from .mesh import polyline_arc
@@ -234,11 +235,16 @@ class FlatPanel:
         uv.setflags(write=False)
         return uv
 
+    @property
+    def motion(self) -> Motion:
+        """The placement ``(angle, dx, dy)`` as a :class:`~patterns.curves.Motion`, what a piece's
+        ``placement`` is."""
+        angle, dx, dy = self.placement
+        return Motion(float(angle), float(dx), float(dy))
+
     def place(self, points) -> np.ndarray:
         """Points of the flattening's own frame, (k, 2) mm, moved by the panel's placement."""
-        angle, dx, dy = self.placement
-        c, s = np.cos(angle), np.sin(angle)
-        return np.asarray(points, dtype=np.float64) @ np.array([[c, s], [-s, c]]) + np.array([dx, dy])
+        return self.motion(points)
 
     def rulings(self, spacing: float) -> list:
         """Straight rulings of an exactly developed cylinder or cone, about ``spacing`` mm apart.

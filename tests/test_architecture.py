@@ -215,3 +215,16 @@ def test_the_service_records_of_warns_and_gives_the_bundles_records():
     with pytest.warns(DeprecationWarning, match=r"records_of goes in 0.3.0"):
         records = records_of("pattern", {"dart_strain": 0.03}, name="x")
     assert records[patterns.FlattenOptions].max_strain == 0.03 and records[patterns.CheckOptions].max_strain is None
+
+
+def test_a_panels_placement_is_the_motion_a_piece_has(duct):
+    """One meaning per name: ``FlatPanel.motion`` is its placement as the ``Motion`` a piece's ``placement`` is;
+    the drawing's pieces of a laid-out pattern sit where their panels' motions put them."""
+    import numpy as np
+
+    laid = duct.placed([(0.3 * k, 100.0 * k, -50.0 * k) for k in range(len(duct.panels))])
+    for flat in laid.panels:
+        np.testing.assert_allclose(flat.motion(flat.flattening.uv), flat.uv, atol=1e-12)
+        a, dx, dy = flat.placement
+        c, s = np.cos(a), np.sin(a)
+        np.testing.assert_allclose(flat.uv, flat.flattening.uv @ np.array([[c, -s], [s, c]]).T + [dx, dy], atol=1e-9)
