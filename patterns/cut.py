@@ -35,7 +35,7 @@ from .mesh import (
     unique_edges,
 )
 
-__all__ = ["Cut", "Inserted", "crease_pieces", "cut_along", "cut_to_disk", "insert_line", "is_closed", "pieces",
+__all__ = ["Cut", "Inserted", "components", "crease_regions", "cut_along", "cut_to_disk", "insert_line", "is_closed",
            "shared_chains"]
 
 
@@ -68,8 +68,8 @@ class Cut:
     sides: tuple
 
 
-def pieces(faces: np.ndarray, n_vertices: int, *, name: str = "mesh") -> list[np.ndarray]:
-    """Split faces into connected pieces (joined through shared edges).
+def components(faces: np.ndarray, n_vertices: int, *, name: str = "mesh") -> list[np.ndarray]:
+    """Split faces into connected components (joined through shared edges): what a mesh file's panels are.
 
     Parameters
     ----------
@@ -102,7 +102,7 @@ def is_closed(faces: np.ndarray, n_vertices: int, *, name: str = "mesh") -> bool
     return bool((edge_tables(faces, n_vertices, name=name).edge_faces[:, 1] >= 0).all())
 
 
-def crease_pieces(vertices: np.ndarray, faces: np.ndarray, *, angle: float, name: str = "mesh") -> list[np.ndarray]:
+def crease_regions(vertices: np.ndarray, faces: np.ndarray, *, angle: float, name: str = "mesh") -> list[np.ndarray]:
     """Split a piece into the regions its creases bound: edges whose two faces meet at more than ``angle``.
 
     Parameters
@@ -137,7 +137,7 @@ def shared_chains(faces: np.ndarray, groups: list) -> list[tuple[int, int, np.nd
     ----------
     faces : (m, 3) int64
     groups : list of (m_i,) int64
-        A partition of the faces into regions (see :func:`crease_pieces`).
+        A partition of the faces into regions (see :func:`crease_regions`).
 
     Returns
     -------
@@ -229,7 +229,7 @@ def cut_to_disk(vertices: np.ndarray, faces: np.ndarray, *, name: str = "mesh") 
     ----------
     vertices : (n, 3) float64
     faces : (m, 3) int64
-        One piece (see :func:`pieces`).
+        One component (see :func:`components`).
     name : str
         For error messages.
 

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .cut import crease_pieces, cut_to_disk, is_closed, pieces, shared_chains
+from .cut import components, crease_regions, cut_to_disk, is_closed, shared_chains
 from .errors import CadError, InputError, MeshTopologyError
 from .files import check_input_file
 from .mesh import MAX_TRIANGLES, as_mesh_arrays, check_faces_have_area, drop_unused, polyline_length, unique_ints
@@ -479,14 +479,14 @@ def mesh_model(vertices, faces, *, name: str = "mesh", crease_angle: float = 60.
                          f"or split it into parts")
     check_faces_have_area(v, f, name=name)
     panels, seams, cuts, split = [], [], 0, 0
-    groups = pieces(f, len(v), name=name)
+    groups = components(f, len(v), name=name)
     for i, group in enumerate(groups):
         pname = name if len(groups) == 1 else f"{name}: piece{i}"
         used = unique_ints(f[group])
         regions = [np.arange(len(group))]
         local = np.searchsorted(used, f[group])  # the piece's faces on its own vertices
         if is_closed(local, len(used), name=pname):
-            regions = crease_pieces(v[used], local, angle=crease_angle, name=pname)
+            regions = crease_regions(v[used], local, angle=crease_angle, name=pname)
             if len(regions) == 1:
                 cut_to_disk(v[used], local, name=pname)  # a torus: refused for its handles first
                 raise MeshTopologyError(

@@ -7,7 +7,7 @@ import trimesh
 
 import patterns
 from patterns import surfaces
-from patterns.cut import cut_along, pieces
+from patterns.cut import components, cut_along
 from patterns.errors import MeshTopologyError
 from patterns.mesh import validate_mesh
 
@@ -19,7 +19,7 @@ def _euler(v, f):
 
 def test_pieces_are_the_connected_parts():
     f = np.array([[0, 1, 2], [3, 4, 5], [2, 1, 6]])
-    groups = pieces(f, 7)
+    groups = components(f, 7)
     assert sorted(sorted(g.tolist()) for g in groups) == [[0, 2], [1]]
 
 
@@ -143,16 +143,16 @@ def test_several_paths_are_cut_at_once():
 
 
 def test_a_closed_box_splits_at_its_creases_into_its_faces():
-    """crease_pieces on a box: six regions of two triangles, each flat; shared_chains: its twelve edges,
+    """crease_regions on a box: six regions of two triangles, each flat; shared_chains: its twelve edges,
     each one straight segment between two regions, as long as the box edge."""
     import trimesh
 
-    from patterns.cut import crease_pieces, is_closed, shared_chains
+    from patterns.cut import crease_regions, is_closed, shared_chains
 
     box = trimesh.creation.box((100.0, 60.0, 40.0))
     v, f = np.asarray(box.vertices), np.asarray(box.faces)
     assert is_closed(f, len(v))
-    regions = crease_pieces(v, f, angle=60.0)
+    regions = crease_regions(v, f, angle=60.0)
     assert sorted(len(r) for r in regions) == [2] * 6
     for r in regions:  # each region flat: one normal
         p = v[f[r]]
@@ -163,18 +163,18 @@ def test_a_closed_box_splits_at_its_creases_into_its_faces():
     assert len(chains) == 12 and all(a < b for a, b, _ in chains)
     lengths = sorted(round(float(np.linalg.norm(v[path[-1]] - v[path[0]])), 9) for _, _, path in chains)
     assert lengths == [40.0] * 4 + [60.0] * 4 + [100.0] * 4
-    (whole,) = crease_pieces(v, f, angle=95.0)  # no edge sharper than 95 degrees: one region
+    (whole,) = crease_regions(v, f, angle=95.0)  # no edge sharper than 95 degrees: one region
     assert sorted(whole) == list(range(12))
 
 
 def test_a_can_splits_into_caps_and_side_with_closed_rims():
     import trimesh
 
-    from patterns.cut import crease_pieces, shared_chains
+    from patterns.cut import crease_regions, shared_chains
 
     can = trimesh.creation.cylinder(radius=30.0, height=80.0, sections=32)
     v, f = np.asarray(can.vertices), np.asarray(can.faces)
-    regions = crease_pieces(v, f, angle=60.0)
+    regions = crease_regions(v, f, angle=60.0)
     assert len(regions) == 3
     chains = shared_chains(f, regions)
     assert len(chains) == 2  # the two rims, between the side and each cap

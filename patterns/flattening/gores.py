@@ -23,13 +23,13 @@ from ..pattern import Flattening
 from .curvature import gore_bound
 from .darts import dart_lines, worst_strain
 from .inserts import relieved
-from .remedy import FlatPiece, Remedy
+from .remedy import Flattener, Remedy
 from .split import split_panel
 
 __all__ = ["gore_paths", "gore_search", "gored"]
 
 
-def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, flat: FlatPiece, *,
+def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, flat: Flattener, *,
           max_slashes: int = 0) -> Model:
     """The model with panel ``index`` split into the fewest gores that each flatten within ``limit``.
 
@@ -42,7 +42,7 @@ def gored(model: Model, index: int, result: Flattening, limit: float, max_cuts: 
     return model if found is None else found.model
 
 
-def gore_search(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, flat: FlatPiece, *,
+def gore_search(model: Model, index: int, result: Flattening, limit: float, max_cuts: int, flat: Flattener, *,
                 max_slashes: int = 0) -> Remedy | None:
     """Panel ``index`` split into the fewest gores within ``limit`` (the worst gore's strain, the model).
 
@@ -60,7 +60,7 @@ def gore_search(model: Model, index: int, result: Flattening, limit: float, max_
         panel, one more to a crown on its outline).
     flat : callable
         ``flat(model, p) -> PanelFlat``: a gore flattened as :func:`patterns.flatten` flattens it
-        (:data:`patterns.flattening.remedy.FlatPiece`).
+        (:data:`patterns.flattening.remedy.Flattener`).
     max_slashes : int
         A gore above the limit that is saddle-shaped (a seat's waist) is
         slashed and given inserts, at most this many slashes

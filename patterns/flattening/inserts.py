@@ -45,7 +45,7 @@ from ..model import Model
 from ..pattern import Flattening
 from .curvature import crown_of, gore_bound
 from .darts import cut_darts, worst_strain
-from .remedy import FlatPiece, Remedy
+from .remedy import Flattener, Remedy
 from .split import flat_piece, split_panel
 
 __all__ = ["is_saddle", "relieved", "slash_search", "slashed"]
@@ -187,7 +187,7 @@ class _Outline:
         return v, f, paths
 
 
-def relieved(model: Model, first: int, count: int, limit: float, flat: FlatPiece, *, max_slashes: int,
+def relieved(model: Model, first: int, count: int, limit: float, flat: Flattener, *, max_slashes: int,
              max_darts: int | None = None) -> Remedy:
     """Pieces just split from one panel, each brought towards ``limit``: slashed where saddle-shaped, else darted.
 

@@ -22,7 +22,7 @@ from .gores import gore_search, gored
 from .grain import grain_table, turn_to_grain
 from .inserts import is_saddle, slashed
 from .parted import darts_needed, parted
-from .remedy import FlatPiece, PanelFlat, Remedy
+from .remedy import Flattener, PanelFlat, Remedy
 from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
 from .settings import FlattenOptions
 
@@ -192,7 +192,7 @@ def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> tupl
     return model, darted
 
 
-def _darted(model: Model, i: int, start: PanelFlat, opts: FlattenOptions, flat: FlatPiece) -> Remedy:
+def _darted(model: Model, i: int, start: PanelFlat, opts: FlattenOptions, flat: Flattener) -> Remedy:
     """Panel ``i`` (``start``: it flattened without darts; ``flat`` flattens a piece) darted whole, or, where
     darts alone fall short of the limit, parted into pieces with darts (:func:`.parted.parted`), or else cut
     into dartless gores (:func:`.gores.gore_search`): the first that meets the limit, or the one that came

@@ -40,7 +40,7 @@ from ..pattern import Flattening
 from .curvature import gore_bound
 from .gores import gore_paths
 from .inserts import relieved
-from .remedy import FlatPiece, Remedy
+from .remedy import Flattener, Remedy
 from .split import split_panel
 
 __all__ = ["darts_needed", "parted"]
@@ -56,7 +56,7 @@ def darts_needed(result: Flattening, limit: float) -> float:
 
 
 def parted(model: Model, index: int, result: Flattening, limit: float, max_darts: int, max_pieces: int,
-           flat: FlatPiece) -> Remedy | None:
+           flat: Flattener) -> Remedy | None:
     """Panel ``index`` parted into the fewest pieces tried that each come within ``limit`` with darts.
 
     Parameters

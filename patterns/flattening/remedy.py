@@ -5,7 +5,7 @@ pattern maker has -- darts (:mod:`.darts`), pieces with darts (:mod:`.parted`), 
 slashes with inserts (:mod:`.inserts`) -- and keeps whichever meets the limit first, or came closest.  Each
 remedy answers in one of these records, side by side here:
 
-* :class:`PanelFlat` -- a panel flattened as :func:`patterns.flatten` flattens it (what a :data:`FlatPiece`
+* :class:`PanelFlat` -- a panel flattened as :func:`patterns.flatten` flattens it (what a :data:`Flattener`
   gives): its flattening, its held seam lengths, the engine's keywords;
 * :class:`Darted` -- a panel with its darts cut (:func:`.darts.cut_darts`);
 * :class:`Remedy` -- a panel split (parted, gored, slashed): the worst piece's strain, the model with the
@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from ..model import Model
 from ..pattern import DartSearch, Flattening
 
-__all__ = ["Darted", "FlatPiece", "PanelFlat", "Remedy"]
+__all__ = ["Darted", "Flattener", "PanelFlat", "Remedy"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,8 +43,9 @@ class PanelFlat:
     options: dict
 
 
-FlatPiece = Callable[[Model, int], PanelFlat]
-"""``flat(model, p) -> PanelFlat``: panel ``p`` of a model flattened as :func:`patterns.flatten` flattens it."""
+Flattener = Callable[[Model, int], PanelFlat]
+"""``flat(model, p) -> PanelFlat``: flattens panel ``p`` of a model (a split panel's piece) as
+:func:`patterns.flatten` flattens a panel."""
 
 
 @dataclass(frozen=True, eq=False)

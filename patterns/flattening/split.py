@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..cut import cut_along, pieces
+from ..cut import components, cut_along
 from ..mesh import polyline_length, unique_edges
 from ..model import Model, Seam, panel_from_mesh
 from ..pattern import Flattening
@@ -38,7 +38,7 @@ def split_panel(model: Model, index: int, paths, *, inserts: bool = False) -> Mo
     vertices, faces, cuts = paths
     panel = model.panels[index]
     cut = cut_along(vertices, faces, cuts, name=panel.name)
-    groups = pieces(cut.faces, len(cut.vertices), name=panel.name)
+    groups = components(cut.faces, len(cut.vertices), name=panel.name)
     if len(groups) < 2:
         return None
     labels = [f"{panel.name}-{j + 1}" for j in range(len(groups))]
