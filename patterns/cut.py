@@ -35,8 +35,8 @@ from .mesh import (
     unique_edges,
 )
 
-__all__ = ["Cut", "Inserted", "components", "crease_regions", "cut_along", "cut_to_disk", "insert_line", "is_closed",
-           "shared_chains"]
+__all__ = ["Cut", "Inserted", "chains", "components", "crease_regions", "cut_along", "cut_to_disk", "insert_line",
+           "is_closed", "shared_chains"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -158,7 +158,7 @@ def shared_chains(faces: np.ndarray, groups: list) -> list[tuple[int, int, np.nd
     edges = t.edges[between]
     for a, b in _unique_pairs(pairs):
         chosen = edges[(pairs[:, 0] == a) & (pairs[:, 1] == b)]
-        out += [(int(a), int(b), path) for path in _chains(chosen)]
+        out += [(int(a), int(b), path) for path in chains(chosen)]
     return out
 
 
@@ -167,8 +167,9 @@ def _unique_pairs(pairs: np.ndarray) -> np.ndarray:
     return np.unique(pairs, axis=0) if len(pairs) else pairs.reshape(0, 2)
 
 
-def _chains(edges: np.ndarray) -> list[np.ndarray]:
-    """Edges ``(k, 2)`` joined into maximal paths (split where a vertex has other than two), then cycles."""
+def chains(edges: np.ndarray) -> list[np.ndarray]:
+    """Edges ``(k, 2)`` int64 joined into maximal vertex paths ((p,) int64: split where a vertex has other than
+    two), then cycles (first vertex repeated last)."""
     neighbours: dict = {}
     for a, b in edges.tolist():
         neighbours.setdefault(a, []).append(b)

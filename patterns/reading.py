@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .cut import components, crease_regions, cut_to_disk, is_closed, shared_chains
+from .cut import chains, components, crease_regions, cut_along, cut_to_disk, is_closed, shared_chains
 from .errors import CadError, InputError, MeshTopologyError
 from .files import check_input_file
 from .mesh import MAX_TRIANGLES, as_mesh_arrays, check_faces_have_area, drop_unused, polyline_length, unique_ints
@@ -442,7 +442,7 @@ def load(source, options: LoadOptions | None = None, **keywords):
     raise InputError(f"cannot load a {type(source).__name__}: give a file path or a build123d shape")
 
 
-def mesh_model(vertices, faces, *, name: str = "mesh", crease_angle: float = 60.0):
+def mesh_model(vertices, faces, *, name: str = "mesh", crease_angle: float = 60.0, seams=None):
     """A :class:`Model` from a triangle mesh: one panel per connected piece, cut open where needed.
 
     Parameters
@@ -455,6 +455,10 @@ def mesh_model(vertices, faces, *, name: str = "mesh", crease_angle: float = 60.
         along its creases, the edges whose faces meet at more than this many
         degrees; the creases become seams.  A closed piece without such
         creases (a sphere) is refused: one cut cannot lay it flat.
+    seams : (k, 2) int, optional
+        Edges marked as seams (Blender's ``use_seam``): the mesh is cut open along them first, and each
+        chain of marked edges becomes a seam between the panels on its two sides (on one panel where it
+        does not part it: a tube cut along one line).  An edge on the mesh's boundary is a seam already.
 
     Returns
     -------
@@ -478,7 +482,13 @@ def mesh_model(vertices, faces, *, name: str = "mesh", crease_angle: float = 60.
         raise InputError(f"{name}: {len(f)} triangles, over the limit of {MAX_TRIANGLES:.0e}; decimate the mesh "
                          f"or split it into parts")
     check_faces_have_area(v, f, name=name)
+    marked = _marked_seams(v, f, seams, name)
+    if marked:
+        opened = cut_along(v, f, marked, name=name)
+        v, f = np.asarray(opened.vertices), np.asarray(opened.faces)
+        marked = list(zip(marked, opened.sides))
     panels, seams, cuts, split = [], [], 0, 0
+    where = np.full((len(v), 2), -1, dtype=np.int64)  # each vertex's (panel, index in it), first copy
     groups = components(f, len(v), name=name)
     for i, group in enumerate(groups):
         pname = name if len(groups) == 1 else f"{name}: piece{i}"
@@ -506,6 +516,7 @@ def mesh_model(vertices, faces, *, name: str = "mesh", crease_angle: float = 60.
             cut = cut_to_disk(v[used][rv], rf, name=rname)
             panels.append(panel_from_mesh(label, cut.vertices, cut.faces, name=rname))
             maps.append(rv)
+            where[used[rv]] = np.stack([np.full(len(rv), len(panels) - 1), np.arange(len(rv))], axis=1)
             for path, (left, right) in zip(cut.paths, cut.sides):
                 points = v[used][rv][path]
                 seams.append(Seam(id=len(seams), panels=(len(panels) - 1,) * 2, points=points,
@@ -517,7 +528,38 @@ def mesh_model(vertices, faces, *, name: str = "mesh", crease_angle: float = 60.
                 sides = tuple(np.searchsorted(maps[r], path) for r in (a, b))
                 seams.append(Seam(id=len(seams), panels=(first + a, first + b), points=points, vertices=sides,
                                   length=polyline_length(points)))
+    for path, (left, right) in marked:  # the marked seams, each between the panels on its two sides
+        points = v[left]
+        (pl, *_), (pr, *_) = where[left, 0], where[right, 0]
+        seams.append(Seam(id=len(seams), panels=(int(pl), int(pr)), points=points,
+                          vertices=(where[left, 1], where[right, 1]), length=polyline_length(points)))
     edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     longest = float(np.linalg.norm(v[edges[:, 1]] - v[edges[:, 0]], axis=1).max())
     return Model(name=name, panels=tuple(panels), seams=tuple(seams), max_edge=longest,
                  bookkeeping=Bookkeeping(cuts=cuts, split=split))
+
+
+def _marked_seams(v: np.ndarray, f: np.ndarray, seams, name: str) -> list:
+    """The marked seam edges as vertex paths (:func:`patterns.cut.chains`), those on the boundary left out;
+    InputError for an edge the mesh has not."""
+    if seams is None:
+        return []
+    try:
+        edges = np.asarray(seams, dtype=np.int64).reshape(-1, 2)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: seams must be pairs of vertex indices (k x 2)") from None
+    if not len(edges):
+        return []
+    half = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    n = len(v)
+    count = np.bincount(np.minimum(half[:, 0], half[:, 1]) * n + np.maximum(half[:, 0], half[:, 1]))
+    lo, hi = np.minimum(edges[:, 0], edges[:, 1]), np.maximum(edges[:, 0], edges[:, 1])
+    bad = (lo < 0) | (hi >= n) | (lo == hi)
+    keys = np.where(bad, 0, lo * n + hi)
+    faces_of = np.where(bad | (keys >= len(count)), 0, count[np.minimum(keys, len(count) - 1)])
+    missing = np.flatnonzero(bad | (faces_of == 0))
+    if len(missing):
+        a, b = edges[missing[0]]
+        raise InputError(f"{name}: seam edge ({a}, {b}) is no edge of the mesh ({len(missing)} such)")
+    inner = np.unique(np.stack([lo, hi], axis=1)[faces_of == 2], axis=0)
+    return chains(inner)

@@ -160,15 +160,27 @@ def test_shutdown_ends_the_worker():
 
 
 def _host_engine():
-    spec = importlib.util.spec_from_file_location("patterns_wb_engine", ADDON / "engine.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """FreeCAD's ``engine.py`` with the hosts' worker client beside it, as ``patterns freecad install`` puts them
+    (a package of their own, in a temporary folder: nothing of FreeCAD's is needed)."""
+    import shutil
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="patterns-host-")) / "patterns_host_side"
+    folder.mkdir()
+    (folder / "__init__.py").write_text("")
+    shutil.copy2(ADDON / "engine.py", folder / "engine.py")
+    shutil.copy2(host.CLIENT, folder / "client.py")
+    spec = importlib.util.spec_from_file_location("patterns_host_side", folder / "__init__.py",
+                                                  submodule_search_locations=[str(folder)])
+    package = importlib.util.module_from_spec(spec)
+    sys.modules["patterns_host_side"] = package
+    spec.loader.exec_module(package)
+    return importlib.import_module("patterns_host_side.engine")
 
 
 def test_the_host_side_imports_nothing_but_freecad_and_the_standard_library():
     allowed = set(sys.stdlib_module_names) | {"FreeCAD", "FreeCADGui", "Part", "PySide"}
-    for path in ADDON.glob("*.py"):
+    for path in [*ADDON.glob("*.py"), Path(host.CLIENT)]:
         for node in ast.walk(ast.parse(path.read_text())):
             names = [a.name for a in node.names] if isinstance(node, ast.Import) else (
                 [node.module] if isinstance(node, ast.ImportFrom) and not node.level else [])
@@ -278,7 +290,7 @@ def test_install_and_uninstall(tmp_path, capsys):
     installed = sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file())
     shipped = sorted(p.relative_to(host.ADDON).as_posix() for p in host.ADDON.rglob("*")
                      if p.is_file() and "__pycache__" not in p.parts)
-    assert installed == sorted(shipped + ["engine.json"])
+    assert installed == sorted(shipped + ["engine.json", "freecad/patterns_wb/client.py"])
     assert str(folder) in capsys.readouterr().out
     assert main(["freecad", "install", "--user-dir", str(tmp_path)]) == 0  # again: replaced
     assert main(["freecad", "uninstall", "--user-dir", str(tmp_path)]) == 0

@@ -23,10 +23,12 @@ from pathlib import Path
 
 from ..errors import InputError
 
-__all__ = ["ADDON", "NAME", "install", "uninstall", "user_dir"]
+__all__ = ["ADDON", "CLIENT", "NAME", "install", "uninstall", "user_dir"]
 
 ADDON = Path(__file__).resolve().parent / "freecad_addon"
 """The workbench's files, as they go into ``Mod/patterns``."""
+CLIENT = Path(__file__).resolve().parent / "client.py"
+"""The worker's client (standard library only), copied into every host's package."""
 NAME = "patterns"
 """The folder's name in ``Mod``."""
 MARK = "engine.json"
@@ -74,6 +76,7 @@ def install(user: Path | None = None) -> Path:
     try:
         folder = staging / NAME
         shutil.copytree(ADDON, folder, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        shutil.copy2(CLIENT, folder / "freecad" / "patterns_wb" / "client.py")  # the worker's client, shared
         record = {"command": _engine_command(), "version": __version__, "protocol": PROTOCOL}
         (folder / MARK).write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
         if target.exists():  # the old one aside, the new one in, then the old one gone: never neither

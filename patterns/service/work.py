@@ -25,6 +25,7 @@ from ..errors import InputError
 from ..export import WriteOptions, write
 from ..export.layers import PRESETS
 from ..flattening import flatten
+from ..measure import triangle_strains
 from ..nesting import layout
 from ..pattern import Pattern
 from ..pieces import Drawing, drawing_of, piece_labels
@@ -101,7 +102,8 @@ def _compute(kind: str, shape: str, options: dict, name: str, key: str = "") -> 
         if kind != "pattern":
             raise InputError(f"{name}: a blank is unfolded from a CAD shape (BREP), not a mesh")
         mesh = json.loads(shape)
-        model = mesh_model(np.asarray(mesh["vertices"], dtype=np.float64), np.asarray(mesh["faces"]), name=name)
+        model = mesh_model(np.asarray(mesh["vertices"], dtype=np.float64), np.asarray(mesh["faces"]), name=name,
+                           seams=mesh.get("seams"))
         subject = flatten(model, bundle.flatten)
     elif kind == "pattern":
         model = mesh_shape(brep.from_brep(shape, name), bundle.load, name=name)
@@ -173,8 +175,37 @@ def make(results: Results, request: dict) -> dict:
         "report": str(made.report),
         "figures": figures(made.report),
         "face_strain": _face_strain(made, n_faces),
+        **(_flat(made, shape) if shape.startswith("{") else {}),
         "seconds": time.perf_counter() - started,
     }
+
+
+def _flat(made: Made, shape: str) -> dict:
+    """For a mesh: ``flat``, each piece as a flat mesh where the drawing lays it (``vertices`` (n, 2) mm,
+    ``faces``, ``strain`` per face: the dominant principal strain), its cut ``outline`` (mm) and its panel's name;
+    and ``triangle_strain``, the strain of each of the request's triangles (0 where none was flattened)."""
+    from scipy.spatial import cKDTree
+
+    pattern = made.subject
+    pieces = []
+    for piece in made.drawing.pieces:
+        flat = pattern.panels[piece.source.index]
+        strain = triangle_strains(flat.vertices, flat.faces, flat.flattening.uv).dominant
+        pieces.append({"name": piece.name, "panel": flat.name,
+                       "vertices": np.round(piece.placement(flat.uv), 6).tolist(),
+                       "faces": np.asarray(flat.faces).tolist(), "strain": np.round(strain, 8).tolist(),
+                       "outline": np.round(piece.outline.points(0.05), 6).tolist()})
+    mesh = json.loads(shape)
+    v, f = np.asarray(mesh["vertices"], dtype=np.float64), np.asarray(mesh["faces"], dtype=np.int64)
+    centres, strains = [], []
+    for flat in pattern.panels:  # every flattened triangle (a dart's split ones too), where it lies in 3D
+        centres.append(flat.vertices[flat.faces].mean(axis=1))
+        strains.append(triangle_strains(flat.vertices, flat.faces, flat.flattening.uv).dominant)
+    out = np.zeros(len(f))
+    if len(f) and centres:
+        _, nearest = cKDTree(np.concatenate(centres)).query(v[f].mean(axis=1))
+        out = np.concatenate(strains)[nearest]  # each triangle: the flattened triangle at its centre
+    return {"flat": pieces, "triangle_strain": np.round(out, 8).tolist()}
 
 
 def validate(request: dict) -> dict:
@@ -208,10 +239,11 @@ def _fields(request: dict) -> tuple:
     if not isinstance(kind, str):
         raise InputError(f"{name}: kind must be 'pattern' or 'blank'")
     mesh = request.get("mesh")
-    if mesh is not None:  # a mesh instead of a shape: {"vertices": (n, 3) mm, "faces": (m, 3) indices}
+    if mesh is not None:  # a mesh: {"vertices": (n, 3) mm, "faces": (m, 3) indices, "seams": (k, 2) edges}
         if not isinstance(mesh, dict) or not {"vertices", "faces"} <= set(mesh):
             raise InputError(f"{name}: mesh must be an object with vertices (n x 3, mm) and faces (m x 3)")
-        shape = json.dumps({"vertices": mesh["vertices"], "faces": mesh["faces"]}, separators=(",", ":"))
+        shape = json.dumps({"vertices": mesh["vertices"], "faces": mesh["faces"], "seams": mesh.get("seams") or []},
+                           separators=(",", ":"))
     if not isinstance(shape, str) or shape.startswith("{") and mesh is None:
         raise InputError(f"{name}: shape must be BREP text (or give a mesh)")
     return kind, shape, options, name
