@@ -14,25 +14,18 @@ Windows.
 
 from __future__ import annotations
 
-import json
 import os
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
-from ..errors import InputError
+from .placing import CLIENT, MARK, place, record_text, remove
 
 __all__ = ["ADDON", "CLIENT", "NAME", "install", "uninstall", "user_dir"]
 
 ADDON = Path(__file__).resolve().parent / "freecad_addon"
 """The workbench's files, as they go into ``Mod/patterns``."""
-CLIENT = Path(__file__).resolve().parent / "client.py"
-"""The worker's client (standard library only), copied into every host's package."""
 NAME = "patterns"
 """The folder's name in ``Mod``."""
-MARK = "engine.json"
-"""The file that says a ``Mod/patterns`` folder is ours (an uninstall removes no other)."""
 
 
 def user_dir(given: Path | None = None, *, environ=None, platform: str | None = None, home: Path | None = None) -> Path:
@@ -52,54 +45,17 @@ def user_dir(given: Path | None = None, *, environ=None, platform: str | None = 
     return Path(environ.get("XDG_DATA_HOME") or home / ".local" / "share") / "FreeCAD"
 
 
-def _engine_command() -> list:
-    return [sys.executable, "-m", "patterns"]
-
-
 def install(user: Path | None = None) -> Path:
     """Put the workbench into ``<user>/Mod/patterns`` (replacing an earlier one of ours) and record this
     interpreter as its engine; returns the folder.  InputError if the place is taken by something else or
     cannot be written."""
-    from .. import __version__
-    from ..service import PROTOCOL
-
-    mod = user_dir(user) / "Mod"
-    target = mod / NAME
-    if target.is_symlink() or (target.exists() and not (target / MARK).is_file()):
-        raise InputError(f"{target}: a folder that is not a patterns workbench is in the way (0.1.0's clone or link "
-                         f"of the repository? move it aside: docs/freecad.md)")
-    try:
-        mod.mkdir(parents=True, exist_ok=True)
-        staging = Path(tempfile.mkdtemp(prefix=".patterns-", dir=mod))
-    except OSError as exc:
-        raise InputError(f"{mod}: cannot write there ({exc.strerror})") from None
-    try:
-        folder = staging / NAME
-        shutil.copytree(ADDON, folder, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-        shutil.copy2(CLIENT, folder / "freecad" / "patterns_wb" / "client.py")  # the worker's client, shared
-        record = {"command": _engine_command(), "version": __version__, "protocol": PROTOCOL}
-        (folder / MARK).write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
-        if target.exists():  # the old one aside, the new one in, then the old one gone: never neither
-            target.rename(staging / "old")
-        folder.rename(target)
-    except OSError as exc:
-        raise InputError(f"{target}: cannot install there ({exc.strerror or exc})") from None
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-    return target
+    target = user_dir(user) / "Mod" / NAME
+    return place(ADDON, target, files={MARK: record_text(), "freecad/patterns_wb/client.py": CLIENT},
+                 not_ours="a folder that is not a patterns workbench is in the way (0.1.0's clone or link of the "
+                          "repository? move it aside: docs/freecad.md)")
 
 
 def uninstall(user: Path | None = None) -> Path | None:
     """Take the workbench out of ``<user>/Mod``; returns the folder removed, or None if there was none.
     InputError if the folder there is not ours."""
-    target = user_dir(user) / "Mod" / NAME
-    if not target.exists():
-        return None
-    if target.is_symlink() or not (target / MARK).is_file():
-        raise InputError(f"{target}: not a patterns workbench installed by `patterns freecad install` (no {MARK}); "
-                         f"left as it is")
-    try:
-        shutil.rmtree(target)
-    except OSError as exc:
-        raise InputError(f"{target}: cannot remove it ({exc.strerror or exc})") from None
-    return target
+    return remove(user_dir(user) / "Mod" / NAME, what="a patterns workbench installed by `patterns freecad install`")
