@@ -150,7 +150,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _host_commands(sub) -> None:
-    """``serve`` (the engine for a CAD program) and ``freecad install|uninstall``."""
+    """``serve`` (the engine for a CAD program), ``freecad install|uninstall`` and ``blender install|uninstall``."""
     sub.add_parser("serve", help="run the engine for a CAD program (FreeCAD's workbench): JSON lines on standard "
                                  "input and output (docs/worker.md)")
     host = sub.add_parser("freecad", help="put the Patterns workbench into FreeCAD (install), or take it out "
@@ -159,6 +159,15 @@ def _host_commands(sub) -> None:
     host.add_argument("--user-dir", type=Path, default=None, metavar="DIR",
                       help="FreeCAD's user data folder (Mod inside; default: $FREECAD_USER_DATA, $FREECAD_USER_HOME, "
                            "or the platform's)")
+    blender = sub.add_parser("blender", help="put the Patterns add-on into Blender 4.2+ (install), or take it out "
+                                             "(uninstall); the engine stays in this environment")
+    blender.add_argument("action", choices=("install", "uninstall"), help="install or uninstall")
+    blender.add_argument("--target", type=Path, default=None, metavar="DIR",
+                         help="the add-ons folder (default: $BLENDER_USER_SCRIPTS/addons, or scripts/addons of every "
+                              "Blender 4.2 or later in Blender's user folder)")
+    blender.add_argument("--zip", type=Path, default=None, metavar="FILE",
+                         help="install: write the add-on as a zip for Preferences > Add-ons > Install from Disk "
+                              "instead")
 
 
 def _parse(argv) -> argparse.Namespace:
@@ -528,8 +537,29 @@ def _cmd_freecad(args) -> int:
     return EXIT_OK
 
 
+def _cmd_blender(args) -> int:
+    from .hosts import blender
+
+    if args.action == "install" and args.zip is not None:
+        if args.target is not None:
+            raise InputError("give --target or --zip, not both")
+        path = blender.write_zip(args.zip)
+        print(f"wrote {path}: in Blender, Edit > Preferences > Add-ons > Install from Disk, then enable Patterns; its "
+              f"engine is {sys.executable} (this environment)")
+    elif args.action == "install":
+        for folder in blender.install(args.target):
+            print(f"installed the Patterns add-on in {folder}; its engine is {sys.executable} (this environment)")
+        print("in Blender: Edit > Preferences > Add-ons, enable Patterns; the tools are in the 3D view's sidebar (N)")
+    else:
+        if args.zip is not None:
+            raise InputError("--zip goes with install")
+        gone = blender.uninstall(args.target)
+        print("\n".join(f"removed {g}" for g in gone) if gone else "no Patterns add-on found")
+    return EXIT_OK
+
+
 COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "demo": _cmd_demo, "unfold": _cmd_unfold,
-            "batch": _cmd_batch, "freecad": _cmd_freecad}
+            "batch": _cmd_batch, "freecad": _cmd_freecad, "blender": _cmd_blender}
 
 
 # --------------------------------------------------------------------------- #
