@@ -157,12 +157,12 @@ def test_every_module_is_named_in_the_architecture_doc():
     missing = []
     for path in _sources():
         rel = path.relative_to(PACKAGE)
-        if path.stem == "__init__" or "freecad_addon" in rel.parts:
+        if path.stem == "__init__" or "freecad_addon" in rel.parts or "blender_addon" in rel.parts:
             continue
         named = f"{path.stem}.py" in text if len(rel.parts) == 1 else re.search(rf"\b{path.stem}\b", text)
         if not named:
             missing.append(str(rel))
-    assert "freecad_addon/" in text
+    assert "freecad_addon/" in text and "blender_addon/" in text
     assert not missing, missing
 
 

@@ -82,9 +82,9 @@ def _cases():
             yield pytest.param(path, line, lang, code, id=f"{path.relative_to(REPO)}:{line}", marks=marks)
 
 
-def _freecad_block(code: str, line: int) -> str:
-    """The code freecadcmd runs for one block of docs/freecad.md: :func:`run_python_block` on it, from
-    ``docvalues.py`` (the standard library only, as FreeCAD's own Python has it)."""
+def _host_block(code: str, line: int, page: str = "freecad.md") -> str:
+    """The code a host's Python (freecadcmd, Blender's) runs for one block of its page: :func:`run_python_block`
+    on it, from ``docvalues.py`` (the standard library only, as a host's own Python has it)."""
     return (f"if '__doc_run__' not in globals():\n"
             f"    import importlib.util as _u\n"
             f"    _spec = _u.spec_from_file_location('patterns_doc_values', {str(Path(__file__).parent / 'docvalues.py')!r})\n"
@@ -92,7 +92,7 @@ def _freecad_block(code: str, line: int) -> str:
             f"    __import__('sys').modules[_spec.name] = _m\n"
             f"    _spec.loader.exec_module(_m)\n"
             f"    __doc_run__ = _m.run_python_block\n"
-            f"__doc_run__(globals(), {code!r}, 'freecad.md', {line})\n")
+            f"__doc_run__(globals(), {code!r}, {page!r}, {line})\n")
 
 
 def _transcript(code: str):
@@ -192,7 +192,7 @@ def freecad_blocks(tmp_path_factory):
     user = folder / "freecad-user"  # the workbench installed as docs/freecad.md has a user install it
     subprocess.run([*_patterns_command(), "freecad", "install", "--user-dir", str(user)], check=True,
                    capture_output=True, timeout=120)
-    blocks = [(line, _freecad_block(code, line)) for line, lang, code, mark, _ in _blocks(FREECAD_DOC)
+    blocks = [(line, _host_block(code, line)) for line, lang, code, mark, _ in _blocks(FREECAD_DOC)
               if lang == "python" and mark != "skip"]
     (folder / "blocks.json").write_text(json.dumps(blocks))
     env = dict(os.environ, FREECAD_USER_HOME=str(user), BLOCKS=str(folder / "blocks.json"),
@@ -204,10 +204,38 @@ def freecad_blocks(tmp_path_factory):
     return json.loads((folder / "out.json").read_text())
 
 
+BLENDER_DOC = REPO / "docs" / "blender.md"
+
+
+@pytest.fixture(scope="module")
+def blender_blocks(tmp_path_factory):
+    """Every Python block of docs/blender.md run in order in Blender's Python (bpy), the add-on installed by
+    ``patterns blender install --target``: ``{line: "ok" or traceback}``."""
+    from .test_blender import _blender_python
+
+    python = _blender_python()
+    folder = tmp_path_factory.mktemp("blender-docs")
+    (folder / "samples").symlink_to(REPO / "samples")
+    scripts = folder / "scripts"
+    subprocess.run([*_patterns_command(), "blender", "install", "--target", str(scripts / "addons")], check=True,
+                   capture_output=True, timeout=120)
+    blocks = [(line, _host_block(code, line, "blender.md")) for line, lang, code, mark, _ in _blocks(BLENDER_DOC)
+              if lang == "python" and mark != "skip"]
+    (folder / "blocks.json").write_text(json.dumps(blocks))
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(scripts), BLOCKS=str(folder / "blocks.json"),
+               OUT=str(folder / "out.json"), HOME=str(folder))
+    for name in ("PATTERNS_ENGINE", "PYTHONPATH", "VIRTUAL_ENV"):
+        env.pop(name, None)
+    proc = subprocess.run([str(python), str(Path(__file__).parent / "readers" / "blender_docs_run.py")], cwd=folder,
+                          capture_output=True, text=True, env=env, timeout=1200, check=False)
+    assert (folder / "out.json").exists(), proc.stdout[-3000:] + proc.stderr[-3000:]
+    return json.loads((folder / "out.json").read_text())
+
+
 @pytest.mark.parametrize(("path", "line", "lang", "code"), list(_cases()))
 def test_code_block_runs(path, line, lang, code, workdirs, request):
-    if lang == "python" and path == FREECAD_DOC:
-        result = request.getfixturevalue("freecad_blocks")[str(line)]
+    if lang == "python" and path in (FREECAD_DOC, BLENDER_DOC):
+        result = request.getfixturevalue("freecad_blocks" if path == FREECAD_DOC else "blender_blocks")[str(line)]
         assert result == "ok", result
     elif lang == "python":
         _python_up_to(path, line, workdirs)
@@ -333,7 +361,7 @@ def test_the_demo_says_its_limit_and_why(tmp_path):
     assert "cup.step: ok (" in within.stdout
 
 
-@pytest.mark.parametrize("command", ["flatten", "batch", "unfold", "freecad"])
+@pytest.mark.parametrize("command", ["flatten", "batch", "unfold", "freecad", "blender"])
 def test_every_flag_is_in_the_cli_doc(command):
     """docs/cli.md names every flag the command has (the flags come from the option records)."""
     from patterns import cli

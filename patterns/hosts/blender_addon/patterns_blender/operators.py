@@ -5,6 +5,8 @@ report in Blender's status bar (no traceback): no mesh selected, a mesh the engi
 closed without seams, ...), the engine missing (with the commands that install it).
 """
 
+import os
+
 import bpy
 
 from . import geometry, settings
@@ -110,7 +112,7 @@ class PATTERNS_OT_export(bpy.types.Operator):
         if obj is None or obj.type != "MESH":
             self.report({"ERROR"}, "patterns: make a mesh object active to export its pattern")
             return {"CANCELLED"}
-        path = bpy.path.abspath(self.filepath)
+        path = os.path.abspath(bpy.path.abspath(self.filepath))  # the engine runs in another folder
         if not path.lower().endswith((".dxf", ".svg", ".json")):
             self.report({"ERROR"}, f"patterns: {path}: write a .dxf, .svg or .json file")
             return {"CANCELLED"}

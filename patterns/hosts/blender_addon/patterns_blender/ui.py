@@ -16,8 +16,9 @@ class PATTERNS_PT_panel(bpy.types.Panel):
         options = context.scene.patterns
         if not settings.properties():
             layout.label(text="Run `patterns blender install` (no options recorded)", icon="ERROR")
+        shown = {p["name"] for p in settings.properties()}
         for name in settings.MAIN:
-            if hasattr(options, name):
+            if name in shown:
                 layout.prop(options, name)
         row = layout.row(align=True)
         row.operator("patterns.flatten", icon="MOD_UVPROJECT")
