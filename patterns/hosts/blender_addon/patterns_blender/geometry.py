@@ -64,9 +64,9 @@ def colour(strain: float, limit: float) -> list:
     return [1.0, 1.0 - t, 1.0 - t, 1.0] if strain >= 0 else [1.0 - t, 1.0 - t, 1.0, 1.0]
 
 
-def add_pieces(obj, pieces, scale: float, context) -> bpy.types.Collection:
+def add_pieces(obj, pieces, scale: float, context, limit: float = 0.05) -> bpy.types.Collection:
     """The flat pieces as mesh objects in a collection named after ``obj`` (its earlier pieces replaced),
-    each with its strain per face and its cut outline (a child of edges)."""
+    each with its strain per face (and its colour, red at ``limit``) and its cut outline (a child of edges)."""
     name = f"{obj.name} pattern"
     collection = bpy.data.collections.get(name)
     if collection is None:
@@ -83,6 +83,12 @@ def add_pieces(obj, pieces, scale: float, context) -> bpy.types.Collection:
         mesh.update()
         attribute = mesh.attributes.new(STRAIN, "FLOAT", "FACE")
         attribute.data.foreach_set("value", piece["strain"])
+        colours = mesh.color_attributes.new(COLOUR, "FLOAT_COLOR", "CORNER")
+        rgba = []
+        for polygon in mesh.polygons:
+            rgba += colour(piece["strain"][polygon.index], limit) * polygon.loop_total
+        colours.data.foreach_set("color", rgba)
+        mesh.color_attributes.active_color = colours
         flat = bpy.data.objects.new(piece["name"], mesh)
         flat["patterns_panel"] = piece["panel"]
         collection.objects.link(flat)

@@ -50,9 +50,9 @@ class PATTERNS_OT_flatten(bpy.types.Operator):
                 reply, polygons, n_polygons, scale, mesh = _make(context, obj)
             except (EngineError, Refused) as exc:
                 return _failed(self, exc)
-            geometry.add_pieces(obj, reply["flat"], scale, context)
-            painted = geometry.paint_strain(obj, reply["triangle_strain"], polygons, n_polygons,
-                                            settings.limit(context.scene.patterns))
+            limit = settings.limit(context.scene.patterns)
+            geometry.add_pieces(obj, reply["flat"], scale, context, limit)
+            painted = geometry.paint_strain(obj, reply["triangle_strain"], polygons, n_polygons, limit)
             figures = reply["figures"]
             seams = "" if mesh["seams"] else " (no seams marked: one panel per connected part)"
             said.append(f"{obj.name}: {reply['pieces']} pieces, worst strain {100 * (figures['strain_max'] or 0):.2f} %"
