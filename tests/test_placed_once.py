@@ -81,7 +81,7 @@ def test_a_flatten_that_writes_dxf_svg_and_report_places_each_pieces_labels_once
     pattern = patterns.flatten(patterns.load(SAMPLES / "cup.step"))
     drawing = patterns.pieces.drawing_of(pattern)
     assert counted["placer"] == len(drawing.pieces) == len(pattern.panels)
-    report, checked = patterns.audit.checked_drawing(pattern, drawing, patterns.CheckOptions())
+    _, checked = patterns.audit.checked_drawing(pattern, drawing, patterns.CheckOptions())
     for name in ("cup.dxf", "cup.svg"):
         patterns.write(drawing, tmp_path / name)
     patterns.write(checked, tmp_path / "cup.json")

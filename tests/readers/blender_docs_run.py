@@ -1,3 +1,4 @@
+# ruff: noqa: I001 - bpy first: it puts Blender's own modules (addon_utils) on the path
 """Run with Blender's Python (``bpy`` as a module), ``BLENDER_USER_SCRIPTS=<dir>`` (the add-on installed in
 ``<dir>/addons`` by ``patterns blender install --target``), ``BLOCKS=<json file> OUT=<json file>``: enables the
 add-on as Blender's Preferences do, runs the Python blocks of docs/blender.md in order, in one namespace, and

@@ -1,3 +1,4 @@
+# ruff: noqa: I001 - bpy first: it puts Blender's own modules (addon_utils) on the path
 """The pictures of docs/blender.md, rendered by Blender itself (Workbench, headless): run with Blender's Python
 (``bpy``), ``BLENDER_USER_SCRIPTS=<dir>`` (the add-on installed in ``<dir>/addons`` by ``patterns blender install
 --target``) and ``OUT=<folder>`` (docs/images).  A dome with seams on four meridians, flattened without darts:

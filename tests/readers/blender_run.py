@@ -1,3 +1,4 @@
+# ruff: noqa: I001 - bpy first: it puts Blender's own modules (addon_utils) on the path
 """Run with Blender's Python (``bpy`` as a module) and ``BLENDER_USER_SCRIPTS=<dir>``, the add-on installed in
 ``<dir>/addons`` by ``patterns blender install --target``, ``OUT=<folder>``: enables the add-on with
 ``addon_utils`` as Blender's Preferences do, runs its operators on a tube, a hemisphere and bad input, and
@@ -117,7 +118,25 @@ for name in ("dome.dxf", "dome.svg", "dome.json"):
     bpy.ops.patterns.export(filepath=os.path.join(OUT, name))
 bpy.ops.patterns.export(filepath=os.path.join(OUT, "dome_astm.dxf"), profile="astm")
 
-# 3. What a user gets wrong: one line each, no traceback
+# 3. A real soft-goods shape: BFF's bunny head (a plush's head, one open piece), read by Blender's OBJ importer
+bpy.context.scene.patterns.width = ""
+bpy.context.scene.patterns.dart_strain = ""
+bpy.context.scene.patterns.seam_allowance = 0.0
+bpy.context.scene.unit_settings.scale_length = 1.0
+corpus = os.environ.get("CORPUS", "")
+if corpus and os.path.isfile(os.path.join(corpus, "bff_bunnyhead.obj")):
+    fresh()
+    bpy.ops.wm.obj_import(filepath=os.path.join(corpus, "bff_bunnyhead.obj"))
+    bunny = bpy.context.selected_objects[0]
+    bunny.name = "Bunny"
+    bpy.context.view_layer.objects.active = bunny
+    seen["bunny_sent"] = sent(bunny)
+    bpy.ops.patterns.flatten()
+    seen["bunny_pieces"] = pieces_of(bunny)
+    bpy.ops.patterns.export(filepath=os.path.join(OUT, "bunny.json"))
+    bpy.ops.patterns.export(filepath=os.path.join(OUT, "bunny.dxf"))
+
+# 4. What a user gets wrong: one line each, no traceback
 bpy.context.scene.patterns.width = ""
 fresh()
 seen["no_mesh"] = error_of(lambda: bpy.ops.patterns.flatten())
@@ -133,7 +152,7 @@ bpy.context.view_layer.objects.active = fin
 seen["non_manifold"] = error_of(lambda: bpy.ops.patterns.flatten())
 seen["bad_suffix"] = error_of(lambda: bpy.ops.patterns.export(filepath=os.path.join(OUT, "fin.pdf")))
 os.environ["PATTERNS_ENGINE"] = "/nonexistent/python -m patterns"
-from patterns_blender import engine as host_engine  # noqa: E402 - the add-on's own module, after it is enabled
+from patterns_blender import engine as host_engine  # the add-on's own module, once it is enabled
 
 host_engine.engine().stop()
 host_engine._ENGINE = None

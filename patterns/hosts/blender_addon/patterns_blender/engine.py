@@ -8,8 +8,8 @@ import atexit
 import json
 import os
 
-from .client import EngineError, Refused
 from .client import Engine as _Engine
+from .client import EngineError, Refused
 from .client import configured as _configured
 
 __all__ = ["CONFIG", "SCHEMA", "Engine", "EngineError", "Refused", "configured", "engine", "schema"]
