@@ -266,6 +266,10 @@ def _nested(nest) -> None:
               f"{nest.seconds:.1f} s; --no-nest-cache searches anew)")
     else:
         print(f"nested on {nest} (sparrow searched {nest.seconds:.1f} s)")
+    for sheet in nest.drawing().sheets():
+        length, width = sheet.size
+        print(f"  sheet {sheet.index + 1} ({length:g} x {width:g} mm): {len(sheet.pieces)} pieces, usage "
+              f"{sheet.usage:.1%}, cut {sheet.cut_length:.1f} mm, {sheet.pierces} pierces, {sheet.bends} bends")
 
 
 def _wrote(result, bundle):
@@ -288,6 +292,8 @@ def _wrote(result, bundle):
             print(f"wrote {path} (the DXF at 1:1)")
         else:
             print(f"wrote {path}")
+    for path in result.part.sheet_files:
+        print(f"wrote {path} (one sheet alone)")
 
 
 class _Run:

@@ -167,6 +167,8 @@ class PartResult:
         The resolution of a PNG preview (lowered for a large drawing).
     comparison : patterns.BlankComparison or None
         An unfold compared with another CAD program's flat pattern.
+    sheet_files : tuple of Path
+        Each sheet's own file (``sheet_files``), as named (staged where ``stage`` said).
     """
 
     subject: Pattern | Blank
@@ -178,6 +180,7 @@ class PartResult:
     nest: Layout | None = None
     preview_dpi: float | None = None
     comparison: BlankComparison | None = None
+    sheet_files: tuple = ()
 
 
 
@@ -192,8 +195,8 @@ def _laid_out(subject, bundle: Bundle) -> tuple:
 
 def _write(subject, drawing: Drawing, checked: Drawing, options: WriteOptions, outputs: dict,
            stage: Callable) -> tuple:
-    """Every output, each to where ``stage`` says: ``({kind: staged path}, preview dpi)``."""
-    written, dpi = {}, None
+    """Every output, each to where ``stage`` says: ``({kind: staged path}, preview dpi, sheet files)``."""
+    written, dpi, sheets = {}, None, []
     for kind, path in outputs.items():
         tmp = stage(path, what=OUTPUT_KINDS[kind][1])
         if kind == "pattern" and path.suffix.lower() == ".obj":
@@ -203,6 +206,11 @@ def _write(subject, drawing: Drawing, checked: Drawing, options: WriteOptions, o
         elif kind == "pattern":
             dialect = options.profile if path.suffix.lower() == ".dxf" or options.profile not in _DXF else None
             write(drawing, tmp, replace(options, profile=dialect))
+            if options.sheet_files:  # each sheet a file of its own, for the machine
+                for k, sheet in enumerate(drawing.sheet_drawings(), start=1):
+                    extra = path.with_name(f"{path.stem}-{k}{path.suffix}")
+                    write(sheet, stage(extra, what=f"sheet {k}"), replace(options, profile=dialect))
+                    sheets.append(extra)
         elif kind == "report":
             write(checked, tmp, replace(options, profile="json"))
         elif kind == "heat_map":
@@ -212,7 +220,7 @@ def _write(subject, drawing: Drawing, checked: Drawing, options: WriteOptions, o
         else:
             dpi = preview_dxf(written["pattern"], tmp)
         written[kind] = tmp
-    return written, dpi
+    return written, dpi, tuple(sheets)
 
 
 def flatten_part(source, bundle: Bundle, *, outputs: dict, stage: Callable, progress=None,
@@ -257,9 +265,9 @@ def flatten_part(source, bundle: Bundle, *, outputs: dict, stage: Callable, prog
     report, checked = checked_drawing(pattern, drawing, bundle.check)
     seconds["check"] = time.perf_counter() - start
     start = time.perf_counter()
-    written, dpi = _write(pattern, drawing, checked, bundle.write, outputs, stage)
+    written, dpi, sheets = _write(pattern, drawing, checked, bundle.write, outputs, stage)
     seconds["write"] = time.perf_counter() - start
-    return PartResult(pattern, model, report, drawing, written, seconds, nest, dpi)
+    return PartResult(pattern, model, report, drawing, written, seconds, nest, dpi, sheet_files=sheets)
 
 
 def unfold_part(source, bundle: Bundle, *, outputs: dict, stage: Callable,
@@ -289,6 +297,6 @@ def unfold_part(source, bundle: Bundle, *, outputs: dict, stage: Callable,
         checked = replace(checked, report={**checked.report, "comparison": comparison.to_dict(reference.path)})
     seconds["check"] = time.perf_counter() - start
     start = time.perf_counter()
-    written, dpi = _write(blank, drawing, checked, bundle.write, outputs, stage)
+    written, dpi, sheets = _write(blank, drawing, checked, bundle.write, outputs, stage)
     seconds["write"] = time.perf_counter() - start
-    return PartResult(blank, None, report, drawing, written, seconds, nest, dpi, comparison)
+    return PartResult(blank, None, report, drawing, written, seconds, nest, dpi, comparison, sheets)

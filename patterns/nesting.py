@@ -68,6 +68,12 @@ SHEET_SPACING = 100.0
 SIMPLIFY = 0.05
 """Outlines are offered to sparrow simplified within this, mm (outwards: the gap holds on the true one)."""
 
+SNAP = 0.01
+"""mm: a piece sparrow leaves past its roll's or sheet's edge by at most this -- its single-precision noise,
+measured up to 2.1 µm on a 300 mm sheet -- is moved back onto it by that much before the check (the gap
+between pieces has 2 x :data:`SIMPLIFY` to spare, more than the move): the nester's own round-off never costs
+a nest."""
+
 MAX_PIECES = 2000
 """The most pieces one nest takes (copies and mirror images counted).  Sparrow's set-up before its timed search
 grows with the pieces (measured on the cup's panels, 10 s budget: 1,000 pieces 15 s in all, 2,000 pieces 22 s,
@@ -77,8 +83,10 @@ SETUP_GRACE = 20.0
 """Seconds sparrow's process may run past its search budget before it is stopped (its start and set-up), plus
 :data:`SETUP_PER_PIECE` a piece."""
 
-SETUP_PER_PIECE = 0.02
-"""Seconds of set-up allowed a piece past the budget (measured: about 6 ms a piece of the cup)."""
+SETUP_PER_PIECE = 0.1
+"""Seconds of set-up allowed a piece past the budget: a stop for a sparrow that hangs, never for one that works
+(measured: about 6 ms a piece of the cup on an idle machine, and 2000 pieces needed 51 s on a loaded one, where
+0.02 s a piece refused them after 61 s)."""
 
 
 def _sheet(value, option_name):
@@ -325,8 +333,7 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
     searched = []  # per marker: True if sparrow searched, False if it came from the cache
     try:
         placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline, searched=searched)
-        laid = tuple(piece.moved(Motion(*placements[i])) for i, piece in enumerate(every))
-        placed = [_outline(piece, opts.margin) for piece in laid]
+        laid, placed = _laid(every, placements, stock, opts.margin)
         _verify(name, laid, placed, across, opts, stock)
     except LayoutError:
         if not opts.cache:
@@ -334,8 +341,7 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
         # a kept marker that fails the check (edited, or from a broken run): searched anew, and kept again
         placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline, refresh=True,
                                             searched=searched)
-        laid = tuple(piece.moved(Motion(*placements[i])) for i, piece in enumerate(every))
-        placed = [_outline(piece, opts.margin) for piece in laid]
+        laid, placed = _laid(every, placements, stock, opts.margin)
         _verify(name, laid, placed, across, opts, stock)
     seconds = time.perf_counter() - start
     area_pieces = float(sum(p.area for p in placed))
@@ -417,12 +423,27 @@ def _tolerance(across: float) -> float:
     return 1e-6 * max(float(across), 1.0)
 
 
+def _strip_width(shapes, across: float, along: float | None) -> float:
+    """The width of strip sparrow is given: the roll's or sheet's, or less where the pieces are far smaller than it
+    -- twice the largest piece's extent or twice the side of a square of their area, and (on a sheet of length
+    ``along``) wide enough to hold their area at :data:`FILL` within its length.  Sparrow's first strip is
+    their area over the width: on a 3000 mm sheet one 40 x 98 mm blank made it 1.3 mm long, and sparrow
+    stopped ("Offset resulted in an empty polygon"); any placement on the narrower strip lies on the stock."""
+    area = float(sum(s.area for s in shapes))
+    extent = max((max(b[2] - b[0], b[3] - b[1]) for b in (s.bounds for s in shapes)), default=0.0)
+    need = max(2.0 * extent, 2.0 * math.sqrt(area))
+    if along is not None:
+        need = max(need, 1.5 * area / (FILL * along))
+    return float(min(across, need))
+
+
 def _solve(shapes, which, across, opts, name, *, seconds: int | None = None, refresh: bool = False,
-           searched: list | None = None) -> dict:
+           searched: list | None = None, along: float | None = None) -> dict:
     """Sparrow on the pieces ``which``: ``{piece: (angle rad, dx, dy)}`` on a roll ``across`` wide, searching
     ``seconds`` (at most ``opts.time_limit``, the marker's key); ``refresh`` searches anew over a kept marker;
     ``searched`` (a list) gets True if sparrow searched, False if the marker was a kept one."""
     points = [_item_points(shapes[i]) for i in which]
+    across = _strip_width([shapes[i] for i in which], across, along)
     # sparrow keeps every item the separation away from the strip's edges too, and each item it sees is
     # the outline grown by SIMPLIFY: a strip wider by both on either side, and everything moved back by
     # them, lets the true outlines touch the roll's edges (as a cutter may) -- a piece as wide as the roll
@@ -481,8 +502,9 @@ def _sparrow(task: dict, name: str, *, seconds: int | None = None) -> list:
     try:
         out, err = proc.communicate(json.dumps({**task, "time": seconds}).encode(), timeout=limit)
     except subprocess.TimeoutExpired:
-        raise LayoutError(f"{name}: sparrow did not end within {limit:.0f} s (a {seconds} s search and its set-up "
-                          f"for {len(task['items'])} pieces): stopped; nest fewer pieces at a time") from None
+        raise LayoutError(f"{name}: sparrow did not end within {limit:.0f} s (this search's {seconds} s of the "
+                          f"nest's {task['time']} s budget, and the set-up of {len(task['items'])} pieces): stopped; "
+                          f"nest fewer pieces at a time") from None
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -568,19 +590,21 @@ def _fill_sheets(shapes, pieces, opts, name, deadline, refresh=False, searched=N
         start = time.monotonic()
         expected = max(1, math.ceil(sum(shapes[i].area for i in left) / (FILL * length * width)))
         share = max(1.0, (deadline - start) / expected)
-        found = _solve(shapes, left, width, opts, name, seconds=max(1, int(share / 2)), refresh=refresh, searched=searched)
+        found = _solve(shapes, left, width, opts, name, seconds=max(1, int(share / 2)), refresh=refresh,
+                       searched=searched, along=length)
         ends = _ends(shapes, found)
         on_sheet = [i for i in left if ends[i] <= length + 1e-9]
         if not on_sheet:  # the nearest piece alone, from the start of the sheet
             i = min(left, key=lambda j: found[j][2])
-            found = _solve(shapes, [i], width, trial, name, seconds=1, refresh=refresh, searched=searched)
+            found = _solve(shapes, [i], width, trial, name, seconds=1, refresh=refresh, searched=searched,
+                           along=length)
             on_sheet = [i]
         found = {i: found[i] for i in on_sheet}
         for i in sorted((j for j in left if j not in on_sheet), key=lambda j: -shapes[j].area):
             if time.monotonic() - start + 1 > share:
                 break
             attempt = _solve(shapes, on_sheet + [i], width, trial, name, seconds=max(1, int(share / 10)),
-                             refresh=refresh, searched=searched)
+                             refresh=refresh, searched=searched, along=length)
             if max(_ends(shapes, attempt).values()) <= length + 1e-9:
                 on_sheet.append(i)
                 found = attempt
@@ -593,6 +617,41 @@ def _fill_sheets(shapes, pieces, opts, name, deadline, refresh=False, searched=N
         stock.append((0.0, offset, width, offset + length))
         left = [i for i in left if i not in on_sheet]
     return placements, sheets, stock
+
+
+def _laid(every, placements, stock, margin: float) -> tuple:
+    """``(pieces moved, their outlines with the margin)``: each piece where sparrow put it, moved back onto its
+    roll or sheet where sparrow left it past an edge by no more than :data:`SNAP` (its float noise)."""
+    rects = [(x0, y0, x1, np.inf if y1 is None else y1) for x0, y0, x1, y1 in stock]
+    laid, placed = [], []
+    for i, piece in enumerate(every):
+        moved = piece.moved(Motion(*placements[i]))
+        shape = _outline(moved, margin)
+        shift = _onto_stock(shape.bounds, rects)
+        if shift != (0.0, 0.0):
+            moved = moved.moved(Motion(0.0, *shift))
+            shape = _outline(moved, margin)
+        laid.append(moved)
+        placed.append(shape)
+    return tuple(laid), placed
+
+
+def _onto_stock(bounds, rects) -> tuple:
+    """``(dx, dy)`` mm that moves an outline whose ``bounds`` are ``(x0, y0, x1, y1)`` back inside the rectangle
+    of ``rects`` (``(x0, y0, x1, y1)`` each) that holds its middle, when it lies past that rectangle's edges by
+    no more than :data:`SNAP`; ``(0, 0)`` when it lies inside, lies farther off (the check then refuses the
+    nest), or on no rectangle."""
+    x0, y0, x1, y1 = bounds
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    for a0, b0, a1, b1 in rects:
+        if a0 <= cx <= a1 and b0 <= cy <= b1:
+            low = (a0 - x0, b0 - y0)  # > 0: past the low edge by that much
+            high = (x1 - a1, y1 - b1)
+            worst = max(*low, *high)
+            if 0.0 < worst <= SNAP:
+                return (max(low[0], 0.0) - max(high[0], 0.0), max(low[1], 0.0) - max(high[1], 0.0))
+            return (0.0, 0.0)
+    return (0.0, 0.0)
 
 
 def _verify(name, laid, placed, across, opts, stock) -> None:

@@ -14,6 +14,8 @@ from patterns.curves import Motion
 from patterns.errors import InputError, LayoutError
 from patterns.nesting import NestOptions
 
+from .conftest import SAMPLES
+
 QUICK = {"time_limit": 1, "cache": False}  # sparrow's search, 1 s (enough for these few pieces), searched anew
 
 
@@ -448,3 +450,109 @@ def test_the_marker_of_issue_22():
     a, b = tree.query(polys, predicate="dwithin", distance=10.0 - 1e-6)
     assert not [(i, j) for i, j in zip(a, b) if i < j]  # no two closer than the gap
     assert shapely.box(0.0, 0.0, 1500.0, nest.length).buffer(1e-3).contains(shapely.union_all(polys))
+
+
+@pytest.mark.parametrize(("past", "kept"), [(0.0021, True), (0.0099, True), (0.5, False)])
+def test_a_piece_the_nester_left_a_hair_past_the_sheet_is_moved_back_onto_it(plates, past, kept):
+    """Issue 49: sparrow's single-precision noise left a piece 2.1 µm past a 300 mm sheet and the nest was refused.
+    A piece placed ``past`` mm beyond the sheet's right edge: moved back by exactly that (its outline's bounds read
+    with shapely land on the edge) and the check passes, up to SNAP (0.01 mm); half a millimetre is refused."""
+    from patterns.nesting import SNAP, _laid, _verify
+
+    (piece,) = patterns.pieces.pieces_of(plates)[:1]
+    _, y0, x1, y1 = shapely.Polygon(piece.outline.points()).bounds
+    sheet = (0.0, 0.0, 400.0, 300.0)
+    placement = {0: (0.0, sheet[2] - x1 + past, 20.0 - y0)}  # its right edge `past` beyond the sheet's
+    laid, placed = _laid([piece], placement, [sheet], 0.0)
+    bounds = shapely.Polygon(laid[0].outline.points()).bounds
+    opts = NestOptions(sheet=(300.0, 400.0))
+    if kept:
+        assert past <= SNAP and bounds[2] == pytest.approx(sheet[2], abs=1e-9)
+        assert bounds[3] - bounds[1] == pytest.approx(y1 - y0, abs=1e-9)  # moved, not changed
+        _verify("plates", laid, placed, 400.0, opts, [sheet])
+    else:
+        assert bounds[2] == pytest.approx(sheet[2] + past, abs=1e-9)  # left where it was: refused
+        with pytest.raises(LayoutError, match="lies off the roll or sheet"):
+            _verify("plates", laid, placed, 400.0, opts, [sheet])
+
+
+@pytest.mark.slow
+def test_a_real_blank_nests_on_a_sheet_for_every_seed_and_copy_count():
+    """Issue 49: no feasible nest refused for its seed: the bracket's blank, 1 to 6 copies on a sheet with room
+    for them, seeds 0 to 4, each nest read back with shapely (on the sheet, apart by the gap)."""
+    blank = patterns.unfold(SAMPLES / "bracket.step")
+    w, h = blank.size
+    for copies in (1, 2, 4, 6):
+        for seed in range(5):
+            nest = patterns.layout(blank, sheet=(3 * (max(w, h) + 20), 2 * (max(w, h) + 20)), copies=copies,
+                                   seed=seed, gap=5.0, rotations="free", **QUICK)
+            outlines = _outlines(nest)
+            assert len(outlines) == copies
+            room = shapely.union_all([shapely.box(*r) for r in nest.stock]).buffer(1e-6)
+            assert all(room.contains(o) for o in outlines), (copies, seed)
+            assert copies == 1 or _min_distance(outlines) >= 5.0 - 1e-6, (copies, seed)
+
+
+@pytest.mark.parametrize("sheet", [(600.0, 400.0), (3000.0, 3000.0), (1e7, 1e7)])
+def test_a_small_blank_nests_on_any_sheet_up_to_the_documented_largest(sheet):
+    """Issue 49: a 40 x 98 mm blank on a 3000 mm sheet (and on the documented largest, 1e7 mm) stopped sparrow
+    ("Offset resulted in an empty polygon", "no pole found": its first strip was the pieces' area over the width,
+    1.3 mm long). Each nest read back: on its sheet, its pieces apart by the gap."""
+    blank = patterns.unfold(SAMPLES / "bracket.step")
+    nest = patterns.layout(blank, sheet=sheet, copies=3, gap=5.0, **QUICK)
+    outlines = _outlines(nest)
+    assert len(nest.sheets) == 1 and len(outlines) == 3
+    room = shapely.box(*nest.stock[0]).buffer(1e-6)
+    assert all(room.contains(o) for o in outlines) and _min_distance(outlines) >= 5.0 - 1e-6
+
+
+def test_each_sheet_says_what_a_shop_quotes_it_from(tmp_path, capsys):
+    """Issue 49: a 100 x 50 mm plate with a 10 mm hole cuts 300 + 10 pi mm in 2 pierces (by hand); four of them on
+    one sheet: four times that, 8 pierces, no bends; usage their area over the sheet's. From the JSON report read
+    back, and the command line's line for the sheet."""
+    import math
+
+    step = tmp_path / "plate.step"
+    bd.export_step(bd.Box(100, 50, 2) - bd.Cylinder(5, 2), str(step))
+    blank = patterns.unfold(step)
+    nest = patterns.layout(blank, sheet=(400.0, 300.0), copies=4, gap=5.0, **QUICK)
+    patterns.write(nest, tmp_path / "nest.json")
+    (sheet,) = json.loads((tmp_path / "nest.json").read_text())["sheets"]
+    one = 300.0 + 10.0 * math.pi
+    assert sheet["cut_length_mm"] == pytest.approx(4 * one, abs=1e-3)
+    assert sheet["pierces"] == 8 and sheet["bends"] == 0 and len(sheet["pieces"]) == 4
+    assert sheet["size_mm"] == [400.0, 300.0]
+    assert sheet["usage"] == pytest.approx(4 * (100 * 50 - math.pi * 25) / (400 * 300), abs=1e-6)
+    from patterns.cli import main
+
+    assert main(["unfold", str(step), "-o", str(tmp_path / "p.dxf"), "--sheet", "400x300", "--copies",
+                              "4", "--nest-time", "1", "--no-nest-cache"]) == 0
+    out = capsys.readouterr().out
+    assert f"sheet 1 (400 x 300 mm): 4 pieces, usage {sheet['usage']:.1%}, cut {4 * one:.1f} mm, 8 pierces, 0 bends" \
+        in out
+
+
+def test_sheet_files_write_each_sheet_alone(tmp_path, capsys):
+    """``--sheet-files``: the nest's DXF and one per sheet beside it, each read back: its CUT outlines are the
+    pieces the report puts on that sheet, all inside its STOCK rectangle; every piece on exactly one sheet."""
+    from patterns.cli import main
+
+    out = tmp_path / "b.dxf"
+    assert main(["unfold", str(SAMPLES / "bracket.step"), "-o", str(out), "--sheet", "200x100", "--copies", "5",
+                 "--nest-time", "1", "--no-nest-cache", "--sheet-files", "--report", str(tmp_path / "b.json")]) == 0
+    sheets = json.loads((tmp_path / "b.json").read_text())["sheets"]
+    assert len(sheets) >= 2 and sum(len(s["pieces"]) for s in sheets) == 5
+    for k, sheet in enumerate(sheets, start=1):
+        doc = ezdxf.readfile(tmp_path / f"b-{k}.dxf")
+        cuts = [shapely.Polygon([p[:2] for p in e.get_points("xy")])
+                for e in doc.modelspace().query("LWPOLYLINE[layer=='CUT']")]
+        (stock,) = [shapely.Polygon([p[:2] for p in e.get_points("xy")])
+                    for e in doc.modelspace().query("LWPOLYLINE[layer=='STOCK']")]
+        assert len(cuts) == len(sheet["pieces"]) and all(stock.buffer(1e-6).contains(c) for c in cuts)
+        assert sorted(stock.bounds[2:]) == pytest.approx(sorted(np.array(stock.bounds[:2]) + [200, 100]))
+    assert not (tmp_path / f"b-{len(sheets) + 1}.dxf").exists()
+    capsys.readouterr()
+    (tmp_path / "in").mkdir()
+    (tmp_path / "in" / "bracket.step").write_bytes((SAMPLES / "bracket.step").read_bytes())
+    assert main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--sheet-files"]) == 2
+    assert "not to a batch" in capsys.readouterr().err

@@ -163,6 +163,9 @@ def _options(options, bundle, records, keywords) -> tuple:
         raise InputError(f"give the part's options as a bundle or as keywords, not both ({min(rest)!r})")
     if not isinstance(bundle, Bundle) or bundle.kind != kind:
         raise InputError(f"bundle must be a patterns {kind} Bundle, got {bundle!r}")
+    if bundle.write.sheet_files:
+        raise InputError("sheet_files writes a file per sheet of one part's nest: give it to flatten or unfold, "
+                         "not to a batch")
     if opts.unfold and opts.heat_map:
         raise InputError("a blank is exact: it has no strain heat map (leave out heat_map with unfold)")
     return opts, bundle

@@ -49,6 +49,10 @@ class WriteOptions(Options):
                                     off="leave bend and ruling lines and their labels out (for a cutter that would "
                                         "cut them)")
 
+    sheet_files: bool = option(False, "with a nest on sheets, also write each sheet as a file of its own beside "
+                                      "the pattern (NAME-1.dxf, NAME-2.dxf, ...): the sheet and its pieces alone, "
+                                      "for the machine")
+
     def __post_init__(self):
         super().__post_init__()
         if self.profile == "astm":

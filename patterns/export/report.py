@@ -72,6 +72,7 @@ def write(drawing: Drawing, path, options: WriteOptions) -> None:
                                                   f"{MARGIN:g} mm from both axes"}
     document["pieces"] = [piece_dict(p) for p in drawing.pieces]
     document["stock"] = [list(s) for s in drawing.stock]
+    document["sheets"] = [s.to_dict() for s in drawing.sheets()]  # what a shop quotes each sheet from
     document["note"] = drawing.note
     text = json.dumps(document, indent=2, allow_nan=False)
     with atomic_output(path, what="report") as tmp:

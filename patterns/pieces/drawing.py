@@ -23,10 +23,46 @@ from ..units import Unit
 from .build import pieces_of
 from .options import PieceOptions
 
-__all__ = ["MARGIN", "Drawing", "arrange", "drawing_of", "place_nest", "row_offsets"]
+__all__ = ["MARGIN", "Drawing", "SheetFigures", "arrange", "drawing_of", "place_nest", "row_offsets"]
 
 MARGIN = 5.0
 """Every drawing starts this far (mm) from the X and Y axes, in the first quadrant."""
+
+
+@dataclass(frozen=True)
+class SheetFigures:
+    """What a shop quotes one sheet (or the used length of a roll) from.
+
+    Attributes
+    ----------
+    index : int
+        0 for the first sheet.
+    size : (float, float)
+        ``(length, width)`` of the stock, mm.
+    pieces : tuple of str
+        The names of the pieces on it.
+    usage : float
+        The pieces' cut area over the stock's area (0..1).
+    cut_length : float
+        Every outline and hole the cutter cuts, mm (arcs as arcs).
+    pierces : int
+        Where the cutter pierces: one per closed cut contour (each outline and each hole).
+    bends : int
+        The bend lines of its blanks (a press brake's strokes; a rolled panel's rulings not counted).
+    """
+
+    index: int
+    size: tuple
+    pieces: tuple
+    usage: float
+    cut_length: float
+    pierces: int
+    bends: int
+
+    def to_dict(self) -> dict:
+        return {"index": self.index, "size_mm": [round(self.size[0], 3), round(self.size[1], 3)],
+                "pieces": list(self.pieces), "usage": round(self.usage, 6), "cut_length_mm": round(self.cut_length, 3),
+                "pierces": self.pierces, "bends": self.bends}
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,6 +88,35 @@ class Drawing:
     stock: tuple = ()
     note: str = ""
     report: Mapping | None = field(default=None)
+
+    def sheet_drawings(self) -> tuple:
+        """A drawing per sheet of the stock (a roll's used length is one): the pieces on it, moved with it into
+        a file's frame, named ``"<name> sheet <k>"``; empty when not nested."""
+        out = []
+        for figures, rect in zip(self.sheets(), self.stock):
+            on = tuple(p for p in self.pieces if p.name in set(figures.pieces))
+            pieces, stock = place_nest(on, (rect,))
+            out.append(Drawing(f"{self.name} sheet {figures.index + 1}", pieces, stock,
+                               f"sheet {figures.index + 1} of {len(self.stock)}", self.report))
+        return tuple(out)
+
+    def sheets(self) -> tuple:
+        """A :class:`SheetFigures` per sheet of the stock (a roll's used length is one), each piece on the one
+        that holds its middle; empty when not nested."""
+        out = []
+        for index, (x0, y0, x1, y1) in enumerate(self.stock):
+            on = []
+            for piece in self.pieces:
+                px0, py0, px1, py1 = piece.bounds
+                if x0 <= (px0 + px1) / 2 <= x1 and y0 <= (py0 + py1) / 2 <= y1:
+                    on.append(piece)
+            area = (x1 - x0) * (y1 - y0)
+            out.append(SheetFigures(index, (float(y1 - y0), float(x1 - x0)), tuple(p.name for p in on),
+                                    float(sum(p.area for p in on) / area) if area > 0 else 0.0,
+                                    float(sum(p.outline.length + sum(h.length for h in p.holes) for p in on)),
+                                    sum(1 + len(p.holes) for p in on),
+                                    sum(1 for p in on for b in p.bends if b.direction)))
+        return tuple(out)
 
     @property
     def bounds(self) -> tuple:
