@@ -49,6 +49,7 @@ from .options import Options, check_number, label, option
 from .pieces import Drawing, Piece, PieceOptions, pieces_of
 from .pieces.drawing import place_nest
 from .pieces.labels import with_labels
+from .placement import FILL, SNAP, into_holes, onto_stock, strip_width, with_guests  # noqa: F401 - SNAP: the nest's tolerance, said here too
 
 __all__ = ["ROTATIONS", "SHEET_SPACING", "Layout", "LayoutError", "NestOptions", "Sheet", "cache_folder", "layout"]
 
@@ -67,12 +68,6 @@ SHEET_SPACING = 100.0
 
 SIMPLIFY = 0.05
 """Outlines are offered to sparrow simplified within this, mm (outwards: the gap holds on the true one)."""
-
-SNAP = 0.01
-"""mm: a piece sparrow leaves past its roll's or sheet's edge by at most this -- its single-precision noise,
-measured up to 2.1 µm on a 300 mm sheet -- is moved back onto it by that much before the check (the gap
-between pieces has 2 x :data:`SIMPLIFY` to spare, more than the move): the nester's own round-off never costs
-a nest."""
 
 MAX_PIECES = 2000
 """The most pieces one nest takes (copies and mirror images counted).  Sparrow's set-up before its timed search
@@ -331,16 +326,21 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
             _check_fits(name, piece.name, shape, across, along, opts.rotations)
     start = time.perf_counter()
     searched = []  # per marker: True if sparrow searched, False if it came from the cache
+    guests = into_holes(every, shapes, opts)  # small pieces in the holes of big ones, before sparrow
+    hosts = [i for i in range(len(every)) if i not in guests]
     try:
-        placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline, searched=searched)
+        placements, sheets, stock = _placed([shapes[i] for i in hosts], [every[i] for i in hosts], across, opts,
+                                            name, deadline, searched=searched)
+        placements, sheets = with_guests(placements, sheets, stock, hosts, guests, every)
         laid, placed = _laid(every, placements, stock, opts.margin)
         _verify(name, laid, placed, across, opts, stock)
     except LayoutError:
         if not opts.cache:
             raise
         # a kept marker that fails the check (edited, or from a broken run): searched anew, and kept again
-        placements, sheets, stock = _placed(shapes, every, across, opts, name, deadline, refresh=True,
-                                            searched=searched)
+        placements, sheets, stock = _placed([shapes[i] for i in hosts], [every[i] for i in hosts], across, opts,
+                                            name, deadline, refresh=True, searched=searched)
+        placements, sheets = with_guests(placements, sheets, stock, hosts, guests, every)
         laid, placed = _laid(every, placements, stock, opts.margin)
         _verify(name, laid, placed, across, opts, stock)
     seconds = time.perf_counter() - start
@@ -389,6 +389,12 @@ def _outline(piece: Piece, margin: float):
     return outline.buffer(margin, join_style="mitre") if margin else outline
 
 
+def _material(piece: Piece, margin: float):
+    """The piece's material as placed: its cut outline less its holes, grown by the margin."""
+    shape = shapely.Polygon(piece.outline.points(), [h.points() for h in piece.holes])
+    return shape.buffer(margin, join_style="mitre") if margin else shape
+
+
 def _item_points(shape) -> np.ndarray:
     """The outline offered to sparrow: grown and simplified within SIMPLIFY, in its frame (x along the
     strip = the piece's +Y, y across = its -X)."""
@@ -423,27 +429,13 @@ def _tolerance(across: float) -> float:
     return 1e-6 * max(float(across), 1.0)
 
 
-def _strip_width(shapes, across: float, along: float | None) -> float:
-    """The width of strip sparrow is given: the roll's or sheet's, or less where the pieces are far smaller than it
-    -- twice the largest piece's extent or twice the side of a square of their area, and (on a sheet of length
-    ``along``) wide enough to hold their area at :data:`FILL` within its length.  Sparrow's first strip is
-    their area over the width: on a 3000 mm sheet one 40 x 98 mm blank made it 1.3 mm long, and sparrow
-    stopped ("Offset resulted in an empty polygon"); any placement on the narrower strip lies on the stock."""
-    area = float(sum(s.area for s in shapes))
-    extent = max((max(b[2] - b[0], b[3] - b[1]) for b in (s.bounds for s in shapes)), default=0.0)
-    need = max(2.0 * extent, 2.0 * math.sqrt(area))
-    if along is not None:
-        need = max(need, 1.5 * area / (FILL * along))
-    return float(min(across, need))
-
-
 def _solve(shapes, which, across, opts, name, *, seconds: int | None = None, refresh: bool = False,
            searched: list | None = None, along: float | None = None) -> dict:
     """Sparrow on the pieces ``which``: ``{piece: (angle rad, dx, dy)}`` on a roll ``across`` wide, searching
     ``seconds`` (at most ``opts.time_limit``, the marker's key); ``refresh`` searches anew over a kept marker;
     ``searched`` (a list) gets True if sparrow searched, False if the marker was a kept one."""
     points = [_item_points(shapes[i]) for i in which]
-    across = _strip_width([shapes[i] for i in which], across, along)
+    across = strip_width([shapes[i] for i in which], across, along)
     # sparrow keeps every item the separation away from the strip's edges too, and each item it sees is
     # the outline grown by SIMPLIFY: a strip wider by both on either side, and everything moved back by
     # them, lets the true outlines touch the roll's edges (as a cutter may) -- a piece as wide as the roll
@@ -572,10 +564,6 @@ def _ends(shapes, found) -> dict:
             for i, (angle, dx, dy) in found.items()}
 
 
-FILL = 0.75
-"""The share of a sheet pieces are expected to take, for sharing the nest's time among the sheets to come."""
-
-
 def _fill_sheets(shapes, pieces, opts, name, deadline, refresh=False, searched=None):
     """Sheet after sheet: the pieces nested on a strip as wide as a sheet, those lying wholly within the
     sheet's length kept on it; then each piece left over, largest first, tried on that sheet too (a short
@@ -627,7 +615,7 @@ def _laid(every, placements, stock, margin: float) -> tuple:
     for i, piece in enumerate(every):
         moved = piece.moved(Motion(*placements[i]))
         shape = _outline(moved, margin)
-        shift = _onto_stock(shape.bounds, rects)
+        shift = onto_stock(shape.bounds, rects)
         if shift != (0.0, 0.0):
             moved = moved.moved(Motion(0.0, *shift))
             shape = _outline(moved, margin)
@@ -636,32 +624,15 @@ def _laid(every, placements, stock, margin: float) -> tuple:
     return tuple(laid), placed
 
 
-def _onto_stock(bounds, rects) -> tuple:
-    """``(dx, dy)`` mm that moves an outline whose ``bounds`` are ``(x0, y0, x1, y1)`` back inside the rectangle
-    of ``rects`` (``(x0, y0, x1, y1)`` each) that holds its middle, when it lies past that rectangle's edges by
-    no more than :data:`SNAP`; ``(0, 0)`` when it lies inside, lies farther off (the check then refuses the
-    nest), or on no rectangle."""
-    x0, y0, x1, y1 = bounds
-    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
-    for a0, b0, a1, b1 in rects:
-        if a0 <= cx <= a1 and b0 <= cy <= b1:
-            low = (a0 - x0, b0 - y0)  # > 0: past the low edge by that much
-            high = (x1 - a1, y1 - b1)
-            worst = max(*low, *high)
-            if 0.0 < worst <= SNAP:
-                return (max(low[0], 0.0) - max(high[0], 0.0), max(low[1], 0.0) - max(high[1], 0.0))
-            return (0.0, 0.0)
-    return (0.0, 0.0)
-
-
 def _verify(name, laid, placed, across, opts, stock) -> None:
     """Raise LayoutError unless every gap holds, no two pieces overlap, and all lie on the stock."""
     tol = _tolerance(across)
-    tree = shapely.STRtree(placed)
-    left, right = tree.query(placed, predicate="dwithin", distance=max(opts.gap - tol, 0.0))
+    material = [_material(piece, opts.margin) for piece in laid]  # a piece's holes are room for others
+    tree = shapely.STRtree(material)
+    left, right = tree.query(material, predicate="dwithin", distance=max(opts.gap - tol, 0.0))
     for a, b in zip(left, right):
-        if a < b and (opts.gap > 0 or placed[a].intersection(placed[b]).area > tol):
-            d = placed[a].distance(placed[b])
+        if a < b and (opts.gap > 0 or material[a].intersection(material[b]).area > tol):
+            d = material[a].distance(material[b])
             raise LayoutError(f"{name}: pieces {laid[a].name} and {laid[b].name} lie {d:.3f} mm "
                               f"apart, under the {opts.gap:g} mm gap (the nest is refused, not written)")
     rects = [shapely.box(x0, y0, x1, y1 if y1 is not None else 1e12) for x0, y0, x1, y1 in stock]

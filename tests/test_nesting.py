@@ -556,3 +556,22 @@ def test_sheet_files_write_each_sheet_alone(tmp_path, capsys):
     (tmp_path / "in" / "bracket.step").write_bytes((SAMPLES / "bracket.step").read_bytes())
     assert main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--sheet-files"]) == 2
     assert "not to a batch" in capsys.readouterr().err
+
+
+def test_small_pieces_go_into_the_holes_of_big_ones():
+    """Issue 49: a 200 x 200 mm frame with a 150 x 150 mm window and four 60 x 60 mm squares go on one 220 x 220 mm
+    sheet (the squares fit only in the window), not two; read back with shapely: every square inside the window,
+    everything apart by the gap, on the sheet."""
+    frame = bd.Box(200, 200, 2) - bd.Box(150, 150, 2)
+    squares = [patterns.unfold(bd.Box(60, 60, 2), name=f"square{k}") for k in range(4)]
+    nest = patterns.layout([patterns.unfold(frame, name="frame"), *squares], sheet=(220.0, 220.0), gap=5.0,
+                           rotations="none", **QUICK)
+    assert len(nest.sheets) == 1 and len(nest.sheets[0].pieces) == 5
+    pieces = {p.name: p for p in nest.pieces}
+    (host,) = [p for p in pieces.values() if p.holes]
+    window = shapely.Polygon(host.holes[0].points())
+    guests = [shapely.Polygon(p.outline.points()) for p in pieces.values() if p is not host]
+    assert all(window.buffer(-5.0 + 1e-6).contains(g) for g in guests)
+    assert _min_distance(guests) >= 5.0 - 1e-6
+    sheet = shapely.box(*nest.stock[0]).buffer(1e-6)
+    assert sheet.contains(shapely.Polygon(host.outline.points()))
