@@ -187,23 +187,21 @@ def _flat(made: Made, shape: str) -> dict:
     from scipy.spatial import cKDTree
 
     pattern = made.subject
+    strains = [triangle_strains(flat.vertices, flat.faces, flat.flattening.uv).dominant for flat in pattern.panels]
     pieces = []
-    for piece in made.drawing.pieces:
+    for piece in made.drawing.pieces:  # a copy shares its panel's strains
         flat = pattern.panels[piece.source.index]
-        strain = triangle_strains(flat.vertices, flat.faces, flat.flattening.uv).dominant
         pieces.append({"name": piece.name, "panel": flat.name,
                        "vertices": np.round(piece.placement(flat.uv), 6).tolist(),
-                       "faces": np.asarray(flat.faces).tolist(), "strain": np.round(strain, 8).tolist(),
+                       "faces": np.asarray(flat.faces).tolist(),
+                       "strain": np.round(strains[piece.source.index], 8).tolist(),
                        "outline": np.round(piece.outline.points(0.05), 6).tolist()})
     mesh = json.loads(shape)
     v, f = np.asarray(mesh["vertices"], dtype=np.float64), np.asarray(mesh["faces"], dtype=np.int64)
-    centres, strains = [], []
-    for flat in pattern.panels:  # every flattened triangle (a dart's split ones too), where it lies in 3D
-        centres.append(flat.vertices[flat.faces].mean(axis=1))
-        strains.append(triangle_strains(flat.vertices, flat.faces, flat.flattening.uv).dominant)
     out = np.zeros(len(f))
-    if len(f) and centres:
-        _, nearest = cKDTree(np.concatenate(centres)).query(v[f].mean(axis=1))
+    if len(f) and pattern.panels:  # every flattened triangle (a dart's split ones too), where it lies in 3D
+        centres = np.concatenate([flat.vertices[flat.faces].mean(axis=1) for flat in pattern.panels])
+        _, nearest = cKDTree(centres).query(v[f].mean(axis=1))
         out = np.concatenate(strains)[nearest]  # each triangle: the flattened triangle at its centre
     return {"flat": pieces, "triangle_strain": np.round(out, 8).tolist()}
 
