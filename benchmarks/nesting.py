@@ -2,7 +2,9 @@
 
 The marker of the issue: four pieces of every panel of the cup, duct and hopper samples (36
 pieces) on a 1500 mm roll with a 10 mm gap, turned by multiples of 90 degrees; then the same with
-the grain kept along the roll (0 or 180 degrees); then the same 36 on 2500 x 1250 mm sheets.
+the grain kept along the roll (0 or 180 degrees); then spyrrow alone on the same outlines and budget
+(what the budget's set-up costs); then the same 36 on 2500 x 1250 mm sheets, on stock of several sizes,
+and on a strip as wide as the sheets (the sheets a strip cut to length would take).
 The previous nester (bottom-left, largest first, shapely collision tests; removed by issue 22) is
 read from git at the commit given (``--old``, default 5138836, the last commit that had it) and run
 on the same pieces; each marker is checked with shapely (every gap kept, nothing off the roll).
@@ -19,6 +21,7 @@ import subprocess
 import sys
 import time
 import types
+from importlib.metadata import version
 from pathlib import Path
 
 import numpy as np
@@ -104,18 +107,68 @@ def main(argv=None) -> int:
             vs = f" ({nest.length / old[0] - 1:+.1%} length, {seconds / old[1]:.2f}x time)" if old else ""
             print(f"| sparrow{vs} | {turns} | {budget} | {nest.length:.1f} | {nest.efficiency:.3f} | {seconds:.1f} | "
                   f"{gap:.2f} | {same} |", flush=True)
-    print("\nsheets 2500 x 1250 mm, the same 36 pieces, turned by multiples of 90 degrees:\n")
-    print("| budget s | sheets | usage, sheet by sheet | in all | seconds |")
-    print("|---|---|---|---|---|")
-    for budget in args.budget[:1]:
+    budget = args.budget[0]
+    print(f"\nsparrow alone (spyrrow {version('spyrrow')} in this process, the same outlines and strip as "
+          f"patterns.layout gives it, quarter turns), {budget} s, against patterns.layout's {budget} s budget "
+          f"(making the pieces and sparrow's set-up inside it):\n")
+    print("| nester | budget s | roll used mm | seconds |")
+    print("|---|---|---|---|")
+    length, seconds = sparrow_alone(base, budget)
+    print(f"| spyrrow alone | {budget} | {length:.1f} | {seconds:.1f} |")
+    start = time.perf_counter()
+    nest = patterns.layout(base, width=1500.0, gap=10.0, copies=4, rotations="quarter", time_limit=budget,
+                           cache=False)
+    print(f"| patterns.layout ({nest.length / length - 1:+.1%} length) | {budget} | {nest.length:.1f} | "
+          f"{time.perf_counter() - start:.1f} |", flush=True)
+    print("\nsheets, the same 36 pieces, turned by multiples of 90 degrees, against sparrow's strip as wide as the "
+          "sheet (its length over the sheet's: the sheets a strip cut to length would take, a bound no sheet "
+          "nest beats):\n")
+    print("| stock | budget s | sheets | usage, sheet by sheet | in all | seconds | strip 1250 mm: length, sheets |")
+    print("|---|---|---|---|---|---|---|")
+    strip = patterns.layout(base, width=1250.0, gap=10.0, copies=4, rotations="quarter", time_limit=budget,
+                            cache=False)
+    for stock, label in (((2500.0, 1250.0), "2500 x 1250"),
+                         ([(2500.0, 1250.0), (1250.0, 1250.0)], "2500 x 1250 and 1250 x 1250 remnants"),
+                         ([(2500.0, 1250.0), (1250.0, 1250.0, 1), (800.0, 1250.0, 2)],
+                          "2500 x 1250, one 1250 x 1250 and two 800 x 1250 on hand")):
         start = time.perf_counter()
-        nest = patterns.layout(base, sheet=(2500.0, 1250.0), gap=10.0, copies=4, rotations="quarter",
-                               time_limit=budget, cache=False)
+        nest = patterns.layout(base, sheet=stock, gap=10.0, copies=4, rotations="quarter", time_limit=budget,
+                               cache=False)
         seconds = time.perf_counter() - start
-        print(f"| {budget} | {len(nest.sheets)} | " + ", ".join(f"{s.usage:.1%} ({len(s.pieces)} pieces)"
-                                                          for s in nest.sheets)
-              + f" | {nest.efficiency:.1%} | {seconds:.1f} |")
+        gap = checked_gap(outlines(nest), 10.0, 1250.0)
+        assert gap >= 10.0 - 1e-6
+        print(f"| {label} | {budget} | {len(nest.sheets)} | "
+              + ", ".join(f"{s.usage:.1%} ({len(s.pieces)} on {s.size[0]:g})" for s in nest.sheets)
+              + f" | {nest.efficiency:.1%} | {seconds:.1f} | {strip.length:.1f} mm, {strip.length / 2500.0:.2f} |",
+              flush=True)
     return 0
+
+
+def sparrow_alone(base, budget: int) -> tuple:
+    """``(strip length used mm, seconds)``: spyrrow itself on the outlines patterns.layout hands it (the 36 pieces
+    on the 1500 mm roll, 10 mm gap, quarter turns), one worker, the same seed, in this process."""
+    import spyrrow
+
+    from patterns.nesting import SIMPLIFY, _item_points, _outline
+    from patterns.pieces import pieces_of
+
+    pieces = [p for p in pieces_of(base) for _ in range(4)]
+    items = [spyrrow.Item(str(k), [tuple(q) for q in _item_points(_outline(p, 0.0))], demand=1,
+                          allowed_orientations=[0.0, 90.0, 180.0, 270.0]) for k, p in enumerate(pieces)]
+    edge = 10.0 + SIMPLIFY
+    instance = spyrrow.StripPackingInstance("alone", strip_height=1500.0 + 2 * edge, items=items)
+    config = spyrrow.StripPackingConfig(early_termination=True, total_computation_time=budget,
+                                        min_items_separation=10.0, seed=0, num_workers=1)
+    start = time.perf_counter()
+    solution = instance.solve(config)
+    seconds = time.perf_counter() - start
+    far = 0.0  # as patterns.layout measures the roll used: to the furthest outline's end, from the roll's start
+    for item in solution.placed_items:
+        pts = np.array(items[int(item.id)].shape)
+        turn = np.radians(item.rotation)
+        x = pts[:, 0] * np.cos(turn) - pts[:, 1] * np.sin(turn) + item.translation[0]
+        far = max(far, float(x.max()))
+    return far - edge - SIMPLIFY, seconds
 
 
 if __name__ == "__main__":

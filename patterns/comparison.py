@@ -125,6 +125,26 @@ def _pieces(entity, tolerance: float):
     return None
 
 
+MAX_POINTS = 2_000_000
+"""The most contour points a flat pattern read for comparison may have (the OpenAMR center bracket's, 124 holes,
+is 64 kB of DXF): past it the file is refused, not read for minutes."""
+
+MAX_FLAT_PATTERN_BYTES = 20_000_000
+"""The largest DXF :func:`read_flat_pattern` reads, bytes (checked before ezdxf parses it: 26 MB of R12 LINEs,
+200,000 of them, took 27 s to read and compare; a real flat pattern is under 100 kB)."""
+
+
+def _finite(values) -> bool:
+    """Every number among ``values`` (DXF attributes: numbers, vectors, text) finite."""
+    for value in values:
+        if isinstance(value, float) and not np.isfinite(value):
+            return False
+        if isinstance(value, tuple) or type(value).__name__ == "Vec3":
+            if not all(np.isfinite(float(v)) for v in value):
+                return False
+    return True
+
+
 OPEN_CONTOURS = ("error", "leave-out")
 """What :func:`read_flat_pattern` does with a chain of pieces that does not close."""
 
@@ -156,18 +176,35 @@ def read_flat_pattern(path, *, tolerance: float = 0.001, open_contours: str = "e
     if open_contours not in OPEN_CONTOURS:
         raise InputError(f"{path}: open_contours must be one of {', '.join(map(repr, OPEN_CONTOURS))}, got "
                          f"{open_contours!r}")
+    from .files import check_input_file
+
+    size = check_input_file(path, what="DXF file").stat().st_size
+    if size > MAX_FLAT_PATTERN_BYTES:
+        raise InputError(f"{path}: {size / 1e6:.0f} MB, over the {MAX_FLAT_PATTERN_BYTES // 1_000_000} MB a flat "
+                         f"pattern to compare with may have (is this the right file?)")
     try:
         doc = ezdxf.readfile(str(path))
     except (OSError, ezdxf.DXFError) as exc:
         raise InputError(f"{path}: not a readable DXF file ({exc})") from None
     closed, open_, bends = [], [], []
+    points = 0
     for entity in doc.modelspace():
+        if not _finite(entity.dxf.all_existing_dxf_attribs().values()):
+            raise InputError(f"{path}: a {entity.dxftype()} (handle {entity.dxf.handle}) has a coordinate or size "
+                             f"that is not a finite number")
         if entity.dxftype() == "LINE" and _is_bend(entity, doc):
             bends.append(np.array([entity.dxf.start, entity.dxf.end])[:, :2])
             continue
         got = _pieces(entity, tolerance)
         if got is None:
             continue
+        if not np.all(np.isfinite(got[1])):
+            raise InputError(f"{path}: a {entity.dxftype()} (handle {entity.dxf.handle}) has a point that is not a "
+                             f"finite number")
+        points += len(got[1])
+        if points > MAX_POINTS:
+            raise InputError(f"{path}: over {MAX_POINTS:,} contour points; a flat pattern is far smaller (is this the "
+                             f"right file?)")
         (closed if got[0] else open_).append(got[1])
     chained, left_out = _chain(open_, path, leave_out=open_contours == "leave-out")
     loops = closed + chained
@@ -193,23 +230,27 @@ def read_flat_pattern(path, *, tolerance: float = 0.001, open_contours: str = "e
 def _chain(pieces, path, *, leave_out: bool = False):
     """Join open pieces end to end into closed loops: ``(loops, left out)``, ``left out`` the two end points
     ((2, 2) mm) of every chain that does not close, when ``leave_out`` (else an InputError)."""
+    from scipy.spatial import cKDTree
+
     pieces = [p for p in pieces if len(p) >= 2]
     loops, left_out = [], []
     used = np.zeros(len(pieces), bool)
-    starts = np.array([p[0] for p in pieces]).reshape(-1, 2)
-    ends = np.array([p[-1] for p in pieces]).reshape(-1, 2)
+    ends = np.concatenate([np.array([p[0] for p in pieces]).reshape(-1, 2),
+                           np.array([p[-1] for p in pieces]).reshape(-1, 2)])  # piece k's start, then its end at n + k
+    tree = cKDTree(ends) if len(ends) else None  # each step looks only near its end: a million lines in seconds
+    n = len(pieces)
 
     def take(at):
-        """The unused piece that goes on from ``at``, turned to start there (marked used), or None."""
-        free = np.flatnonzero(~used)
-        if len(free) == 0:
+        """The unused piece that goes on from ``at``, turned to start there (marked used), or None: the nearest
+        end within _JOIN (a tie: the piece read first, its start before its end)."""
+        if tree is None:
             return None
-        ds, de = np.linalg.norm(starts[free] - at, axis=1), np.linalg.norm(ends[free] - at, axis=1)
-        j = int(np.argmin(np.minimum(ds, de)))
-        if min(ds[j], de[j]) > _JOIN:
+        near = [i for i in tree.query_ball_point(at, _JOIN) if not used[i % n]]
+        if not near:
             return None
-        used[free[j]] = True
-        return pieces[free[j]] if ds[j] <= de[j] else pieces[free[j]][::-1]
+        i = min(near, key=lambda i: (float(np.linalg.norm(ends[i] - at)), i % n, i // n))
+        used[i % n] = True
+        return pieces[i % n] if i < n else pieces[i % n][::-1]
 
     for k in range(len(pieces)):
         if used[k]:
@@ -231,7 +272,11 @@ def _chain(pieces, path, *, leave_out: bool = False):
             at = piece[-1]
         else:
             pts = np.concatenate(loop)
-            loops.append(pts[:-1] if np.linalg.norm(pts[-1] - pts[0]) <= _JOIN else pts)
+            pts = pts[:-1] if np.linalg.norm(pts[-1] - pts[0]) <= _JOIN else pts
+            if len(np.unique(pts.round(9), axis=0)) < 3:
+                raise InputError(f"{path}: a contour of fewer than three points (a line drawn there and back, at x "
+                                 f"{pts[0][0]:.3f}, y {pts[0][1]:.3f}) bounds no area")
+            loops.append(pts)
     return loops, left_out
 
 

@@ -16,9 +16,10 @@ border).  Sheets
 lie one after another along the roll's direction, :data:`SHEET_SPACING` apart in
 the drawing.
 
-What sparrow does not do, and so neither does this: it places no piece inside
-another's hole (an outline's holes are not offered as room), and it takes simple
-polygons only (each outline is simplified within 0.05 mm, outwards, so that the
+Sparrow fills only its strip: small pieces go into the holes of big ones before
+it runs (:func:`patterns.placement.into_holes`).  Sheets may be of several sizes
+(the stock on hand, :mod:`patterns.stock`), each sheet of the size that wastes
+least.  Sparrow takes simple polygons only (each outline is simplified within 0.05 mm, outwards, so that the
 gap still holds on the true outline).  Its search runs for a time budget, so the
 marker it stops at depends on how fast the machine ran; every marker found is
 kept (:func:`cache_folder`), so that the same pieces and options give the same
@@ -49,7 +50,8 @@ from .options import Options, check_number, label, option
 from .pieces import Drawing, Piece, PieceOptions, pieces_of
 from .pieces.drawing import place_nest
 from .pieces.labels import with_labels
-from .placement import FILL, SNAP, into_holes, onto_stock, strip_width, with_guests  # noqa: F401 - SNAP: the nest's tolerance, said here too
+from .placement import FILL, SHEET_SPACING, SNAP, fill_sheets, into_holes, onto_stock, strip_width, with_guests  # noqa: F401 - SNAP: the nest's tolerance, said here too
+from .stock import check_sheet, parse_sheet, sheet_sizes
 
 __all__ = ["ROTATIONS", "SHEET_SPACING", "Layout", "LayoutError", "NestOptions", "Sheet", "cache_folder", "layout"]
 
@@ -62,9 +64,6 @@ _ANGLES = {"grain": [0.0, 180.0], "quarter": [0.0, 90.0, 180.0, 270.0], "free": 
 
 _TRIED = np.arange(0.0, 180.0, 1.0)
 """The turns tried, degrees, when checking that a freely turning piece fits (its extents repeat every 180)."""
-
-SHEET_SPACING = 100.0
-"""Between two sheets in the drawing, mm."""
 
 SIMPLIFY = 0.05
 """Outlines are offered to sparrow simplified within this, mm (outwards: the gap holds on the true one)."""
@@ -82,28 +81,6 @@ SETUP_PER_PIECE = 0.1
 """Seconds of set-up allowed a piece past the budget: a stop for a sparrow that hangs, never for one that works
 (measured: about 6 ms a piece of the cup on an idle machine, and 2000 pieces needed 51 s on a loaded one, where
 0.02 s a piece refused them after 61 s)."""
-
-
-def _sheet(value, option_name):
-    if value is None:
-        return None
-    try:
-        length, width = (float(x) for x in value)
-    except (TypeError, ValueError):
-        raise InputError(f"{option_name} must be (length, width) in mm, got {value!r}") from None
-    return (check_number(length, f"{option_name} length (mm)", low=0, low_open=True, high=1e7),
-            check_number(width, f"{option_name} width (mm)", low=0, low_open=True, high=1e7))
-
-
-def _parse_sheet(text: str):
-    """``"2500x1250"`` (command line) as ``(2500.0, 1250.0)``."""
-    parts = text.lower().replace("*", "x").split("x")
-    try:
-        if len(parts) == 2:
-            return tuple(float(p) for p in parts)
-    except ValueError:
-        pass
-    raise ValueError(f"expected LENGTHxWIDTH in mm, e.g. 2500x1250, got {text!r}")
 
 
 def _quantities(value, option_name):
@@ -130,8 +107,11 @@ class NestOptions(Options):
     width: float | None = option(None, "nest the pieces on a roll this wide, mm", low=0, low_open=True, optional=True,
                                  unit="mm", flag="--roll-width")
     sheet: tuple | None = option(None, "nest the pieces on sheets LENGTH x WIDTH mm, filled one after another "
-                                       "(command line: 2500x1250)", check=_sheet, parse=_parse_sheet,
-                                 optional=True, metavar="LxW")
+                                       "(command line: 2500x1250); or on the stock on hand, several sizes, each "
+                                       "with how many there are (2500x1250,1200x800:2; API: [(2500, 1250), "
+                                       "(1200, 800, 2)]), the last sheet the smallest size that takes every piece left",
+                                 check=check_sheet, parse=parse_sheet, optional=True,
+                                 metavar="LxW[,LxW:N]")
     gap: float = option(10.0, "least distance between two pieces, mm", low=0, unit="mm", flag="--nest-gap")
     margin: float = option(0.0, "room kept around each piece's cut outline besides the gap, mm (a kerf, a "
                                 "cutter's clearance)", low=0, high=1000, unit="mm")
@@ -158,10 +138,17 @@ class NestOptions(Options):
         if self.width is not None and self.sheet is not None:
             raise InputError(f"nest on a roll ({label('width')}) or on sheets ({label('sheet')}), not both")
         room = self.gap + 2 * self.margin  # a gap wider than the stock: refused before sparrow sees it
-        if self.width is not None and room >= self.width or self.sheet is not None and room >= min(self.sheet):
-            stock = f"{self.width:g} mm roll" if self.sheet is None else f"{self.sheet[0]:g} x {self.sheet[1]:g} mm sheet"
+        narrow = min(self.sheet_sizes, key=lambda s: min(s.length, s.width), default=None)
+        if self.width is not None and room >= self.width or narrow is not None and room >= min(narrow.length,
+                                                                                               narrow.width):
+            stock = f"{self.width:g} mm roll" if narrow is None else f"{narrow.length:g} x {narrow.width:g} mm sheet"
             raise InputError(f"{label('gap')} {self.gap:g} mm (and {label('margin')} {self.margin:g} mm each side) is as wide as the "
                              f"{stock}: no two pieces could lie side by side")
+
+    @property
+    def sheet_sizes(self) -> tuple:
+        """The sheets' sizes as :class:`~patterns.stock.SheetSize` records, in the order given; () on a roll."""
+        return sheet_sizes(self.sheet)
 
     @property
     def active(self) -> bool:
@@ -180,6 +167,8 @@ class Sheet:
     """mm^2."""
     area: float
     """The sheet's area, mm^2."""
+    size: tuple = ()
+    """``(length, width)``, mm."""
 
     @property
     def usage(self) -> float:
@@ -244,9 +233,15 @@ class Layout:
 
     def __str__(self) -> str:
         if self.sheets:
-            return (f"{len(self.sheets)} sheet{'s' if len(self.sheets) != 1 else ''} of {self.options.sheet[0]:g} x "
-                    f"{self.width:g} mm, usage "
-                    + ", ".join(f"{s.usage:.1%}" for s in self.sheets) + f" ({self.efficiency:.1%} in all)")
+            sizes = {s.size: sum(t.size == s.size for t in self.sheets) for s in self.sheets}
+            if len(sizes) == 1:
+                what = f"{len(self.sheets)} sheet{'s' if len(self.sheets) != 1 else ''} of {self.sheets[0].size[0]:g} x "
+                what += f"{self.sheets[0].size[1]:g} mm"
+            else:
+                what = f"{len(self.sheets)} sheets (" + ", ".join(f"{n} of {a:g} x {b:g} mm"
+                                                                   for (a, b), n in sizes.items()) + ")"
+            return what + ", usage " + ", ".join(f"{s.usage:.1%}" for s in self.sheets) + \
+                f" ({self.efficiency:.1%} in all)"
         return f"a {self.width:g} mm roll: {self.length:.1f} mm used, efficiency {self.efficiency:.1%}"
 
 
@@ -315,22 +310,22 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
             raise InputError(f"{name}: quantities name piece {piece_name!r}; the pieces are {', '.join(names)}")
         counts[names.index(piece_name)] = n
     check_piece_count(name, counts, opts)
-    across = opts.width if opts.width is not None else opts.sheet[1]
-    along = None if opts.sheet is None else opts.sheet[0]
+    sizes = opts.sheet_sizes
     every = _with_copies(base, counts, opts.mirror)
     shapes = [_outline(piece, opts.margin) for piece in every]
-    checked = set()
+    fitting = {}
     for piece, shape in zip(every, shapes):  # a copy fits as its original does: each outline checked once
-        if (key := shapely.to_wkb(shape)) not in checked:
-            checked.add(key)
-            _check_fits(name, piece.name, shape, across, along, opts.rotations)
+        if (key := shapely.to_wkb(shape)) not in fitting:
+            fitting[key] = _check_fits(name, piece.name, shape, opts.width, sizes, opts.rotations)
+    fits = [fitting[shapely.to_wkb(shape)] for shape in shapes]  # per piece, per sheet size: it fits
+    across = opts.width if opts.width is not None else max(s.width for s in sizes)
     start = time.perf_counter()
     searched = []  # per marker: True if sparrow searched, False if it came from the cache
     guests = into_holes(every, shapes, opts)  # small pieces in the holes of big ones, before sparrow
     hosts = [i for i in range(len(every)) if i not in guests]
     try:
-        placements, sheets, stock = _placed([shapes[i] for i in hosts], [every[i] for i in hosts], across, opts,
-                                            name, deadline, searched=searched)
+        placements, sheets, stock = _placed([shapes[i] for i in hosts], [every[i] for i in hosts],
+                                            [fits[i] for i in hosts], across, opts, name, deadline, searched=searched)
         placements, sheets = with_guests(placements, sheets, stock, hosts, guests, every)
         laid, placed = _laid(every, placements, stock, opts.margin)
         _verify(name, laid, placed, across, opts, stock)
@@ -338,16 +333,18 @@ def layout(source, options: NestOptions | None = None, *, pieces: PieceOptions |
         if not opts.cache:
             raise
         # a kept marker that fails the check (edited, or from a broken run): searched anew, and kept again
-        placements, sheets, stock = _placed([shapes[i] for i in hosts], [every[i] for i in hosts], across, opts,
-                                            name, deadline, refresh=True, searched=searched)
+        placements, sheets, stock = _placed([shapes[i] for i in hosts], [every[i] for i in hosts],
+                                            [fits[i] for i in hosts], across, opts, name, deadline, refresh=True,
+                                            searched=searched)
         placements, sheets = with_guests(placements, sheets, stock, hosts, guests, every)
         laid, placed = _laid(every, placements, stock, opts.margin)
         _verify(name, laid, placed, across, opts, stock)
     seconds = time.perf_counter() - start
     area_pieces = float(sum(p.area for p in placed))
     if sheets:
-        length = opts.sheet[0] * len(sheets)
-        used = opts.sheet[0] * opts.sheet[1] * len(sheets)
+        length = float(sum(s.size[0] for s in sheets))
+        used = float(sum(s.area for s in sheets))
+        across = max(s.size[1] for s in sheets)
         rects = tuple(stock)
     else:
         length = max(float(np.max(np.asarray(p.exterior.coords)[:, 1])) for p in placed)
@@ -373,14 +370,23 @@ def _left(deadline: float) -> int:
     return max(1, int(deadline - time.monotonic()))
 
 
-def _placed(shapes, pieces, across, opts, name, deadline, *, refresh=False, searched=None):
-    """``(placements, sheets, stock)``: sparrow's placements on the roll, or sheet after sheet; ``searched``
-    gets a bool per marker (True: sparrow searched; False: a kept one)."""
+def _placed(shapes, pieces, fits, across, opts, name, deadline, *, refresh=False, searched=None):
+    """``(placements, sheets, stock)``: sparrow's placements on the roll, or sheet after sheet
+    (:func:`patterns.placement.fill_sheets`); ``searched`` gets a bool per marker (True: sparrow searched; False:
+    a kept one)."""
     if opts.sheet is None:
         placements = _solve(shapes, list(range(len(shapes))), across, opts, name, seconds=_left(deadline),
                             refresh=refresh, searched=searched)
         return placements, (), [(0.0, 0.0, across, None)]
-    return _fill_sheets(shapes, pieces, opts, name, deadline, refresh, searched)
+    trial = replace(opts, time_limit=max(1, opts.time_limit // 5))  # another key: the short searches of one sheet
+
+    def solve(which, size, seconds, short=False):
+        return _solve(shapes, which, size.width, trial if short else opts, name, seconds=seconds, refresh=refresh,
+                      searched=searched, along=size.length)
+
+    placements, sheets, stock = fill_sheets(shapes, fits, opts.sheet_sizes, solve, deadline, name=name)
+    return placements, [Sheet(k, tuple(pieces[i].name for i in on), area, size.area, (size.length, size.width))
+                        for k, (on, area, size) in enumerate(sheets)], stock
 
 
 def _outline(piece: Piece, margin: float):
@@ -411,16 +417,28 @@ def _extents(shape, rotations: str) -> np.ndarray:
     return boxes[:, 2:] - boxes[:, :2]
 
 
-def _check_fits(name, piece, shape, across, along, rotations):
+def _check_fits(name, piece, shape, width, sizes, rotations) -> tuple:
+    """Per sheet size, whether the piece fits on it in an allowed orientation (``()`` on a roll of ``width``);
+    LayoutError where it fits on no roll or sheet."""
     extents = _extents(shape, rotations)
-    width = float(extents[:, 0].min())
-    if width > across + 1e-9:
-        what = f"{across:g} mm roll" if along is None else f"{along:g} x {across:g} mm sheet"
-        raise LayoutError(f"{name}: piece {piece} is {width:.1f} mm wide, wider than the {what} in every allowed "
-                          f"orientation (rotations={rotations!r})")
-    if along is not None and not np.any((extents[:, 0] <= across + 1e-9) & (extents[:, 1] <= along + 1e-9)):
-        raise LayoutError(f"{name}: piece {piece} does not fit on a {along:g} x {across:g} mm sheet in any allowed "
-                          f"orientation (rotations={rotations!r})")
+    least = float(extents[:, 0].min())
+    if width is not None:
+        if least > width + 1e-9:
+            raise LayoutError(f"{name}: piece {piece} is {least:.1f} mm wide, wider than the {width:g} mm roll in every "
+                              f"allowed orientation (rotations={rotations!r})")
+        return ()
+    fits = tuple(bool(np.any((extents[:, 0] <= s.width + 1e-9) & (extents[:, 1] <= s.length + 1e-9))) for s in sizes)
+    if not any(fits):
+        widest = max(s.width for s in sizes)
+        what = (f"a {sizes[0].length:g} x {sizes[0].width:g} mm sheet" if len(sizes) == 1
+                else "any of the sheets (" + ", ".join(f"{s.length:g} x {s.width:g}" for s in sizes) + " mm)")
+        if least > widest + 1e-9:
+            than = f"the {what[2:]}" if len(sizes) == 1 else f"every sheet ({', '.join(str(s) for s in sizes)})"
+            raise LayoutError(f"{name}: piece {piece} is {least:.1f} mm wide, wider than {than} in every allowed "
+                              f"orientation (rotations={rotations!r})")
+        raise LayoutError(f"{name}: piece {piece} does not fit on {what} in any allowed orientation "
+                          f"(rotations={rotations!r})")
+    return fits
 
 
 def _tolerance(across: float) -> float:
@@ -556,55 +574,6 @@ def _remember(task: dict, placed: list) -> None:
             tmp.write_text(json.dumps(placed))
     except (OSError, PatternsError):
         pass
-
-
-def _ends(shapes, found) -> dict:
-    """How far along the strip each placed piece reaches, mm."""
-    return {i: affinity.translate(affinity.rotate(shapes[i], angle, origin=(0, 0), use_radians=True), dx, dy).bounds[3]
-            for i, (angle, dx, dy) in found.items()}
-
-
-def _fill_sheets(shapes, pieces, opts, name, deadline, refresh=False, searched=None):
-    """Sheet after sheet: the pieces nested on a strip as wide as a sheet, those lying wholly within the
-    sheet's length kept on it; then each piece left over, largest first, tried on that sheet too (a short
-    search of the sheet's pieces and it, kept if all fit), until the sheet's time is spent; the rest go on
-    to the next sheet.  The time left to ``deadline`` is shared among the sheets the pieces left are
-    expected to fill (at :data:`FILL`); each sheet gets at least a second a search."""
-    length, width = opts.sheet
-    left = list(range(len(shapes)))
-    placements, sheets, stock = {}, [], []
-    trial = replace(opts, time_limit=max(1, opts.time_limit // 5))
-    while left:
-        start = time.monotonic()
-        expected = max(1, math.ceil(sum(shapes[i].area for i in left) / (FILL * length * width)))
-        share = max(1.0, (deadline - start) / expected)
-        found = _solve(shapes, left, width, opts, name, seconds=max(1, int(share / 2)), refresh=refresh,
-                       searched=searched, along=length)
-        ends = _ends(shapes, found)
-        on_sheet = [i for i in left if ends[i] <= length + 1e-9]
-        if not on_sheet:  # the nearest piece alone, from the start of the sheet
-            i = min(left, key=lambda j: found[j][2])
-            found = _solve(shapes, [i], width, trial, name, seconds=1, refresh=refresh, searched=searched,
-                           along=length)
-            on_sheet = [i]
-        found = {i: found[i] for i in on_sheet}
-        for i in sorted((j for j in left if j not in on_sheet), key=lambda j: -shapes[j].area):
-            if time.monotonic() - start + 1 > share:
-                break
-            attempt = _solve(shapes, on_sheet + [i], width, trial, name, seconds=max(1, int(share / 10)),
-                             refresh=refresh, searched=searched, along=length)
-            if max(_ends(shapes, attempt).values()) <= length + 1e-9:
-                on_sheet.append(i)
-                found = attempt
-        offset = len(sheets) * (length + SHEET_SPACING)
-        for i in on_sheet:
-            angle, dx, dy = found[i]
-            placements[i] = (angle, dx, dy + offset)
-        area = float(sum(shapes[i].area for i in on_sheet))
-        sheets.append(Sheet(len(sheets), tuple(pieces[i].name for i in on_sheet), area, length * width))
-        stock.append((0.0, offset, width, offset + length))
-        left = [i for i in left if i not in on_sheet]
-    return placements, sheets, stock
 
 
 def _laid(every, placements, stock, margin: float) -> tuple:

@@ -90,7 +90,10 @@ def check_number(value, option: str, *, low=None, high=None, low_open: bool = Fa
     name : str, optional
         What the option belongs to (a file or model name), put first in the message.
     """
-    ok = is_number(value, integer=integer) and not (finite and not np.isfinite(value))
+    try:  # a Python int past 64 bits is a number np.isfinite cannot take (TypeError): finite all the same
+        ok = is_number(value, integer=integer) and not (finite and not np.isfinite(value))
+    except (TypeError, OverflowError):
+        ok = isinstance(value, int) and not isinstance(value, bool)
     if ok and low is not None:
         ok = value > low if low_open else value >= low
     if ok and high is not None:
@@ -116,6 +119,13 @@ def check_ratio(value, option: str, *, name: str | None = None) -> float:
     return float(value)
 
 
+class _Whole(int):
+    """An integer bound, written whole in a message (4294967295, never 4.29497e+09)."""
+
+    def __format__(self, spec):
+        return str(int(self))
+
+
 def _describe(low, high, low_open, high_open, integer) -> str:
     """``"a positive number"``, ``"an integer >= 0"``, ``"a number between 0 and 1"``, ..."""
     kind = "integer" if integer else "number"
@@ -123,8 +133,8 @@ def _describe(low, high, low_open, high_open, integer) -> str:
     if low == 0 and low_open and high == LARGEST_LENGTH:
         return f"a positive {kind} {'<' if high_open else '<='} {high:g}"
     if integer:  # an open end of integers is the next integer in: "between 1 and 100000", never "between 0" for > 0
-        low = None if low is None else (math.floor(low) + 1 if low_open else math.ceil(low))
-        high = None if high is None else (math.ceil(high) - 1 if high_open else math.floor(high))
+        low = None if low is None else _Whole(math.floor(low) + 1 if low_open else math.ceil(low))
+        high = None if high is None else _Whole(math.ceil(high) - 1 if high_open else math.floor(high))
         low_open = high_open = False
     if low is not None and high is not None:
         if low_open or high_open:

@@ -5,6 +5,7 @@ round-off, and the strip's width sparrow is given (:func:`patterns.layout` calls
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import replace
 
 import numpy as np
@@ -12,14 +13,18 @@ import shapely
 from shapely import affinity
 
 from .curves import Motion
+from .errors import LayoutError
 
-__all__ = ["FILL", "SNAP", "into_holes", "onto_stock", "strip_width", "with_guests"]
+__all__ = ["FILL", "SHEET_SPACING", "SNAP", "ends", "fill_sheets", "into_holes", "onto_stock", "strip_width", "with_guests"]
 
 SNAP = 0.01
 """mm: a piece sparrow leaves past its roll's or sheet's edge by at most this -- its single-precision noise,
 measured up to 2.1 µm on a 300 mm sheet -- is moved back onto it by that much before the check (the gap
 between pieces has 2 x :data:`patterns.nesting.SIMPLIFY` to spare, more than the move): the nester's own
 round-off never costs a nest."""
+
+SHEET_SPACING = 100.0
+"""Between two sheets in the drawing, mm."""
 
 FILL = 0.75
 """The share of a sheet pieces are expected to take, for sharing the nest's time among the sheets to come."""
@@ -130,3 +135,85 @@ def onto_stock(bounds, rects) -> tuple:
                 return (max(low[0], 0.0) - max(high[0], 0.0), max(low[1], 0.0) - max(high[1], 0.0))
             return (0.0, 0.0)
     return (0.0, 0.0)
+
+
+def ends(shapes, found) -> dict:
+    """How far along the strip each placed piece reaches, mm."""
+    return {i: affinity.translate(affinity.rotate(shapes[i], angle, origin=(0, 0), use_radians=True), dx, dy).bounds[3]
+            for i, (angle, dx, dy) in found.items()}
+
+
+def fill_sheets(shapes, fits, sizes, solve, deadline: float, *, name: str) -> tuple:
+    """Sheet after sheet, the last one the smallest size on hand that takes what is left: ``(placements, sheets, stock)``.
+
+    For each sheet, the pieces left are nested on a strip as wide as each size still on hand (``solve(which, size,
+    seconds, short=False)``: sparrow), those lying wholly within its length kept.  The sheet is of the smallest
+    size that takes every piece left (the last sheet: its waste is the nest's, and it is made least), else of
+    the size that takes the most of the pieces' area (the fewest sheets); a tie goes to the size given first.
+    (Measured on the 36-piece marker: choosing the best-used size before the last took four sheets where one
+    size takes two -- the small sheet takes the pieces that pack well and leaves the awkward ones.)  Then each piece
+    left over, largest first, is tried on that sheet too (a short search of the sheet's pieces and it, kept if
+    all fit), until the sheet's time is spent; the rest go on to the next sheet.  The time left to ``deadline``
+    (time.monotonic) is shared among the sheets the pieces left are expected to fill (at :data:`FILL` of the
+    largest size), and a sheet's first searches among the sizes tried; each search gets at least a second.
+
+    ``fits[i][k]`` says piece ``i`` fits on size ``k`` (:class:`patterns.stock.SheetSize`) in an allowed turn.
+    ``sheets`` is ``[(pieces on it, their area, size)]``; ``stock`` the sheets' rectangles ``(x0, y0, x1, y1)``,
+    one after another along y, :data:`SHEET_SPACING` apart.  LayoutError (naming ``name``)
+    when the sheets on hand run out with pieces left.
+    """
+    left = list(range(len(shapes)))
+    on_hand = [s.count for s in sizes]  # None: as many as needed
+    if None not in on_hand and sum(s.area * s.count for s in sizes) < sum(s.area for s in shapes):
+        raise LayoutError(f"{name}: the sheets on hand ({', '.join(str(s) for s in sizes)}) are smaller in all than "
+                          f"the pieces; give more sheets, or a size without a count (bought as needed)")
+    placements, sheets, stock = {}, [], []
+    offset = 0.0
+    while left:
+        start = time.monotonic()
+        usable = [k for k in range(len(sizes)) if on_hand[k] != 0 and any(fits[i][k] for i in left)]
+        if not usable:
+            raise LayoutError(f"{name}: the sheets on hand ({', '.join(str(s) for s in sizes)}) run out with "
+                              f"{len(left)} piece{'s' if len(left) != 1 else ''} left to nest; give more sheets, "
+                              f"or a size without a count (bought as needed)")
+        largest = max(sizes[k].area for k in usable)
+        expected = max(1, math.ceil(sum(shapes[i].area for i in left) / (FILL * largest)))
+        share = max(1.0, (deadline - start) / expected)
+        best = None
+        for k in usable:
+            size = sizes[k]
+            which = [i for i in left if fits[i][k]]
+            found = solve(which, size, max(1, int(share / 2 / len(usable))))
+            reach = ends(shapes, found)
+            on_sheet = [i for i in which if reach[i] <= size.length + 1e-9]
+            if not on_sheet:  # the nearest piece alone, from the start of the sheet
+                i = min(which, key=lambda j: found[j][2])
+                found = solve([i], size, 1, short=True)
+                on_sheet = [i]
+            placed = sum(shapes[i].area for i in on_sheet)
+            # the last sheet (it takes every piece left): the smallest such; else the one that takes most (the
+            # fewest sheets: a small sheet before the last takes the pieces that pack well and leaves the
+            # awkward ones to sheets of their own); a tie: the size given first
+            rank = (len(on_sheet) == len(left), -size.area if len(on_sheet) == len(left) else placed)
+            if best is None or rank[0] > best[0][0] or rank[0] == best[0][0] and rank[1] > best[0][1] + 1e-9 * abs(
+                    best[0][1]):
+                best = (rank, k, on_sheet, {i: found[i] for i in on_sheet})
+        _, k, on_sheet, found = best
+        size = sizes[k]
+        for i in sorted((j for j in left if j not in on_sheet and fits[j][k]), key=lambda j: (-shapes[j].area, j)):
+            if time.monotonic() - start + 1 > share:
+                break
+            attempt = solve(on_sheet + [i], size, max(1, int(share / 10)), short=True)
+            if max(ends(shapes, attempt).values()) <= size.length + 1e-9:
+                on_sheet.append(i)
+                found = attempt
+        for i in on_sheet:
+            angle, dx, dy = found[i]
+            placements[i] = (angle, dx, dy + offset)
+        sheets.append((tuple(on_sheet), float(sum(shapes[i].area for i in on_sheet)), size))
+        stock.append((0.0, offset, size.width, offset + size.length))
+        offset += size.length + SHEET_SPACING
+        if on_hand[k] is not None:
+            on_hand[k] -= 1
+        left = [i for i in left if i not in on_sheet]
+    return placements, sheets, stock

@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 import re
 
-__all__ = ["counted", "escape", "printable"]
+__all__ = ["counted", "escape", "printable", "spreadsheet_cell"]
 
 _UNSAFE = re.compile(r"[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
 
@@ -41,6 +41,25 @@ def printable(text) -> str:
     if not isinstance(text, str):
         text = os.fsdecode(text)
     return _UNSAFE.sub(escape, text)
+
+
+_FORMULA = ("=", "+", "-", "@", "\t", "\r", "\uff1d", "\uff0b", "\uff0d", "\uff20")
+"""What a spreadsheet may take a cell's text for the start of a formula by (OWASP's CSV injection list, with the
+full-width forms some spreadsheets read as the same)."""
+
+
+def spreadsheet_cell(text: str) -> str:
+    """``text`` safe as a CSV cell a spreadsheet opens: made :func:`printable`, and a text that starts as a formula
+    could (``=``, ``+``, ``-``, ``@``, a tab or carriage return) gets a leading ``'`` (OWASP's rule: the cell
+    then shows the text, it never runs it).  Numbers are written as numbers, not through this.
+
+    Examples
+    --------
+    >>> spreadsheet_cell("=cmd|' -C calc'!A0"), spreadsheet_cell("bracket"), spreadsheet_cell("-2 mm")
+    ("'=cmd|' -C calc'!A0", 'bracket', "'-2 mm")
+    """
+    text = printable(text)
+    return "'" + text if text.startswith(_FORMULA) else text
 
 
 _IRREGULAR = {"vertex": "vertices", "copy": "copies", "process": "processes", "patch": "patches"}

@@ -299,9 +299,10 @@ def test_quantities_are_whole_counts_within_bounds(value, words):
     assert NestOptions(width=100.0, quantities={"a": 1, 7: 2000}).quantities == {"a": 1, "7": 2000}
 
 
-@pytest.mark.parametrize("value", [(100.0,), "ab", (1, 2, 3), {"length": 100.0}])
+@pytest.mark.parametrize("value", [(100.0,), "ab", (1, 2, 3, 4), {"length": 100.0}])
 def test_a_sheet_is_two_numbers(value):
-    with pytest.raises(InputError, match=r"sheet must be \(length, width\) in mm, got"):
+    with pytest.raises(InputError, match=r"sheet must be \(length, width\) in mm, or \(length, width, sheets on hand\), "
+                                         r"or a list of them, got"):
         NestOptions(sheet=value)
 
 
@@ -415,9 +416,10 @@ def test_a_freely_turning_piece_fits_where_only_one_turn_does(size, sheet):
 
 
 def test_the_ends_along_the_strip_are_the_placed_outlines():
-    """_ends (which pieces lie within a sheet's length) places each outline as Pattern.placed does: a turn
-    about the panel's own origin, then the move."""
-    from patterns.nesting import _ends, _outline
+    """placement.ends (which pieces lie within a sheet's length) places each outline as Pattern.placed does: a
+    turn about the panel's own origin, then the move."""
+    from patterns.nesting import _outline
+    from patterns.placement import ends as _ends
 
     pattern = _rectangles([(120.0, 30.0), (80.0, 60.0), (50.0, 50.0)])
     moves = {0: (np.pi / 2, 300.0, 40.0), 1: (np.pi, 100.0, 500.0), 2: (0.3, -20.0, 7.0)}
@@ -575,3 +577,74 @@ def test_small_pieces_go_into_the_holes_of_big_ones():
     assert _min_distance(guests) >= 5.0 - 1e-6
     sheet = shapely.box(*nest.stock[0]).buffer(1e-6)
     assert sheet.contains(shapely.Polygon(host.outline.points()))
+
+
+def test_the_last_sheet_is_the_smallest_size_that_takes_what_is_left():
+    """Issue 49, remnants: with stock of several sizes the sheet that takes every piece left is the smallest
+    such: one 50 x 50 mm square goes on the 200 x 150 remnant, not on the 2000 x 1000 sheet given first; a
+    300 mm-wide piece that fits only the big sheet goes there (with the square: one sheet, not two)."""
+    nest = patterns.layout(_rectangles([(50.0, 50.0)]), sheet=[(2000.0, 1000.0), (200.0, 150.0)], **QUICK)
+    assert [s.size for s in nest.sheets] == [(200.0, 150.0)]
+    assert nest.sheets[0].usage == pytest.approx(50.0 * 50.0 / (200.0 * 150.0), rel=1e-9)
+    assert nest.area_used == 200.0 * 150.0 and nest.length == 200.0 and nest.width == 150.0
+    assert str(nest).startswith("1 sheet of 200 x 150 mm, usage 8.3%")
+    both = patterns.layout(_rectangles([(300.0, 100.0), (50.0, 50.0)]), sheet=[(200.0, 150.0), (2000.0, 1000.0)],
+                           **QUICK)
+    assert [s.size for s in both.sheets] == [(2000.0, 1000.0)] and len(both.sheets[0].pieces) == 2
+
+
+def test_sheets_on_hand_are_counted_and_each_piece_lies_on_its_own_sheet(tmp_path):
+    """Two 200 x 150 mm remnants on hand, two 120 x 120 mm squares (one a sheet: 120 + gap + 120 > 150 and > 200):
+    both remnants used, each square inside its own sheet's rectangle read back from the DXF; three squares
+    do not fit the two remnants, five are refused before any search (their area alone is larger); four on one
+    remnant and full sheets bought as needed go onto a 400 x 300 sheet too (the report and the drawing say
+    each sheet's size)."""
+    squares = _rectangles([(120.0, 120.0)])
+    nest = patterns.layout(squares, sheet=[(200.0, 150.0, 2)], copies=2, **QUICK)
+    assert [s.size for s in nest.sheets] == [(200.0, 150.0)] * 2
+    assert str(nest) == "2 sheets of 200 x 150 mm, usage 48.0%, 48.0% (48.0% in all)"
+    patterns.write(nest, tmp_path / "nest.dxf")
+    doc = ezdxf.readfile(tmp_path / "nest.dxf")
+    cuts = [shapely.Polygon([p[:2] for p in e.get_points("xy")])
+            for e in doc.modelspace().query("LWPOLYLINE[layer=='CUT']")]
+    stock = [shapely.Polygon([p[:2] for p in e.get_points("xy")])
+             for e in doc.modelspace().query("LWPOLYLINE[layer=='STOCK']")]
+    assert len(cuts) == 2 and len(stock) == 2
+    assert sorted(sorted(np.subtract(s.bounds[2:], s.bounds[:2]).round(6)) for s in stock) == [[150, 200]] * 2
+    assert all(sum(s.buffer(1e-6).contains(c) for s in stock) == 1 for c in cuts)
+    assert len({max(range(2), key=lambda k: stock[k].intersection(c).area) for c in cuts}) == 2
+    with pytest.raises(LayoutError, match=r"the sheets on hand \(200 x 150 mm \(2 on hand\)\) run out with 1 piece "):
+        patterns.layout(squares, sheet=[(200.0, 150.0, 2)], copies=3, **QUICK)
+    with pytest.raises(LayoutError, match=r"the sheets on hand \(200 x 150 mm \(2 on hand\)\) are smaller in all"):
+        patterns.layout(squares, sheet=[(200.0, 150.0, 2)], copies=5, time_limit=60, cache=False)  # no search: at once
+    mixed = patterns.layout(squares, sheet=[(200.0, 150.0, 1), (400.0, 300.0)], copies=4, **QUICK)
+    assert sum(len(s.pieces) for s in mixed.sheets) == 4
+    assert sum(s.size == (200.0, 150.0) for s in mixed.sheets) <= 1
+    assert mixed.area_used == pytest.approx(sum(a * b for a, b in (s.size for s in mixed.sheets)), rel=1e-12)
+    for sheet, (x0, y0, x1, y1) in zip(mixed.sheets, mixed.stock):
+        assert (y1 - y0, x1 - x0) == sheet.size
+
+
+@pytest.mark.parametrize(("value", "words"), [
+    ([(400.0, 300.0), (200.0, 150.0, 0)], "sheet[1] sheets on hand must be an integer between 1 and"),
+    ([(400.0, 300.0), (400.0, 300.0, 2)], "sheet names a size twice"),
+    ([(400.0, 300.0), (200.0,)], "sheet[1] must be (length, width) in mm, or (length, width, sheets on hand)"),
+    ([(400.0, 300.0), (1e8, 150.0)], "sheet[1] length (mm) must be")])
+def test_sheets_on_hand_are_checked(value, words):
+    with pytest.raises(InputError, match=re.escape(words)):
+        NestOptions(sheet=value)
+
+
+def test_sheets_on_hand_on_the_command_line(tmp_path, capsys):
+    """``--sheet 400x300,200x150:1``: parsed to the sizes and the count, each sheet's line names its size."""
+    from patterns.cli import main
+    from patterns.stock import parse_sheet
+
+    assert parse_sheet("2500x1250,1200x800:2") == ((2500.0, 1250.0), (1200.0, 800.0, 2))
+    step = tmp_path / "plate.step"
+    bd.export_step(bd.Box(100, 50, 2), str(step))
+    assert main(["unfold", str(step), "-o", str(tmp_path / "p.dxf"), "--sheet", "2000x1000,200x150:1",
+                 "--nest-time", "1", "--no-nest-cache"]) == 0
+    assert "sheet 1 (200 x 150 mm): 1 pieces" in capsys.readouterr().out
+    assert main(["unfold", str(step), "-o", str(tmp_path / "q.dxf"), "--sheet", "2000x1000,200x150:x"]) == 2
+    assert "--sheet" in capsys.readouterr().err and not (tmp_path / "q.dxf").exists()

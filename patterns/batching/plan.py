@@ -29,7 +29,7 @@ class BatchOptions(Options):
     (or, with ``unfold``, of ``unfold``)."""
 
     jobs: int | None = option(None, "parallel processes on this machine (default: its CPU count); each runs one "
-                                    "BLAS thread when there are several", integer=True, low=1, optional=True,
+                                    "BLAS thread when there are several", integer=True, low=1, high=1024, optional=True,
                               metavar="N")
     scheduler: str | None = option(None, "run on a Dask distributed cluster at this address (tcp://host:8786) "
                                          "instead of local processes; needs patterns[dask] here and patterns on "

@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import csv
 import io
+import numbers
 
 from ..bendsheet import COLUMNS, bend_rows
 from ..errors import InputError
 from ..files import atomic_output
 from ..pieces import Drawing, Piece
+from ..text import spreadsheet_cell
 from ..units import Unit
 from .options import WriteOptions
 
@@ -37,11 +39,17 @@ def rows_of(drawing: Drawing, unit: Unit = Unit.MM) -> list:
 
 
 def _cell(value) -> str:
+    """A number as a number; any text safe to open in a spreadsheet (:func:`patterns.text.spreadsheet_cell`:
+    a part named ``=cmd|...`` is shown, never run)."""
     if value is None:
         return ""
+    if isinstance(value, bool):
+        return str(value)
     if isinstance(value, float):
         return f"{value:.4f}".rstrip("0").rstrip(".") if abs(value) < 1e9 else repr(value)
-    return str(value)
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    return spreadsheet_cell(str(value))
 
 
 def write(drawing: Drawing, path, options: WriteOptions) -> None:
@@ -54,7 +62,7 @@ def write(drawing: Drawing, path, options: WriteOptions) -> None:
     header = [c.replace("_mm", f"_{unit.value}") for c in COLUMNS]
     buffer = io.StringIO()
     out = csv.writer(buffer, lineterminator="\n")
-    out.writerow(header)
+    out.writerow([spreadsheet_cell(c) for c in header])
     for row in rows_of(drawing, unit):
         out.writerow([_cell(v) for v in row.to_dict().values()])
     with atomic_output(path, what="bend sheet") as tmp:

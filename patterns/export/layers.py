@@ -22,6 +22,10 @@ the presets:
 
 Bend lines are dashed in every preset.  A map is a preset, then ``role=LAYER``
 overrides (``"updown,bend_up=UP"``); ``role=`` leaves a role out of the file.
+Two roles a machine treats differently (the outline and a bend line) never
+share a layer, in any case (``cut=bend`` is refused: ``bend`` is ``BEND`` to
+every reader), unless the preset itself draws them so (``solidworks``' rims
+on ``0``, as SolidWorks does).
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from ..errors import InputError
+from ..text import printable
 
 __all__ = ["LINETYPES", "PRESETS", "ROLES", "Layer", "LayerMap", "layer_map"]
 
@@ -94,12 +99,46 @@ class LayerMap:
         """The distinct layers used, in the order of :data:`ROLES` (a layer two roles share once)."""
         seen = {}
         for _, layer in self.layers:
-            if layer is not None and layer.name not in seen:
-                seen[layer.name] = layer
+            if layer is not None and layer.name.casefold() not in seen:  # CUT and Cut: one layer to a reader
+                seen[layer.name.casefold()] = layer
         return list(seen.values())
 
     def __str__(self) -> str:
         return self.name
+
+
+_KINDS = {"cut": "cut", "hole": "cut", "bend": "bend", "bend_up": "bend", "bend_down": "bend"}
+"""Roles a machine treats alike, which may share a layer (the outline and the holes are cut; every bend is
+bent); every other role is a kind of its own."""
+
+
+def _layer_name(name: str, option: str) -> str:
+    """``name`` if a DXF layer may be called so (ezdxf's rule: none of ``<>/\\":;?*=`` and the back quote), with
+    no control character and no ``|`` (AutoCAD's mark of a layer from an external reference); else InputError."""
+    from ezdxf.lldxf.validator import is_valid_layer_name
+
+    if not is_valid_layer_name(name) or "|" in name or any(ord(c) < 32 or ord(c) == 127 for c in name):
+        raise InputError(f"{option}: {printable(name)!r} is not a DXF layer name (none of < > / \\ \" : ; ? * = | ` "
+                         f"or control characters)")
+    return name
+
+
+def _check_shared(layers: dict, preset: dict, option: str) -> None:
+    """InputError where two roles of different kinds (:data:`_KINDS`) land on one layer (DXF layer names are
+    the same in any case: ``bend`` is ``BEND``) and the preset did not put them there: a cutter would cut the
+    bend lines."""
+    by_name: dict = {}
+    for role in ROLES:
+        if layers[role] is not None:
+            by_name.setdefault(layers[role].name.casefold(), []).append(role)
+    for roles in by_name.values():
+        kinds = {_KINDS.get(r, r) for r in roles}
+        own = {preset[r].name.casefold() if preset[r] is not None else None for r in roles}
+        if len(kinds) > 1 and len(own) > 1:
+            name = layers[roles[0]].name
+            raise InputError(f"{option}: roles {', '.join(roles)} would share layer {name!r} (layer names are the "
+                             f"same in any case): a machine cuts, bends or marks a whole layer alike; give each "
+                             f"its own layer")
 
 
 def _item(role, value, option) -> Layer | None:
@@ -110,7 +149,7 @@ def _item(role, value, option) -> Layer | None:
     if isinstance(value, Layer):
         return value
     if isinstance(value, str):
-        return Layer(value, _BASE[role].color, _BASE[role].linetype)
+        return Layer(_layer_name(value, f"{option}[{role!r}]"), _BASE[role].color, _BASE[role].linetype)
     raise InputError(f"{option}[{role!r}] must be a layer name or a patterns.export.layers.Layer, got "
                      f"{type(value).__name__}")
 
@@ -125,6 +164,7 @@ def layer_map(value, option: str = "layer_map") -> LayerMap:
         for role, layer in value.items():
             layers[role] = _item(role, layer, option)
         name = "patterns," + ",".join(f"{k}={getattr(v, 'name', v) or ''}" for k, v in value.items())
+        _check_shared(layers, PRESETS["patterns"], option)
         return LayerMap(name, tuple((r, layers[r]) for r in ROLES))
     if not isinstance(value, str):
         raise InputError(f"{option} must be a preset ({', '.join(PRESETS)}), 'preset,role=LAYER,...' or a mapping, "
@@ -141,4 +181,5 @@ def layer_map(value, option: str = "layer_map") -> LayerMap:
         if not sep:
             raise InputError(f"{option}: expected role=LAYER after the preset, got {part!r}")
         layers[role.strip()] = _item(role.strip(), name.strip(), option)
+    _check_shared(layers, PRESETS[preset], option)
     return LayerMap(value, tuple((r, layers[r]) for r in ROLES))

@@ -19,6 +19,7 @@ import numpy as np
 from ..curves import Motion
 from ..findings import Finding
 from ..pattern import Pattern
+from ..text import printable
 from ..units import Unit
 from .build import pieces_of
 from .options import PieceOptions
@@ -88,6 +89,12 @@ class Drawing:
     stock: tuple = ()
     note: str = ""
     report: Mapping | None = field(default=None)
+
+    def __post_init__(self):
+        # a name from a file name may hold control characters or bytes that are not UTF-8: made safe once, here,
+        # for every writer (an SVG's title, a DXF's text, a CSV's cell, a terminal)
+        object.__setattr__(self, "name", printable(self.name))
+        object.__setattr__(self, "note", printable(self.note))
 
     def sheet_drawings(self) -> tuple:
         """A drawing per sheet of the stock (a roll's used length is one): the pieces on it, moved with it into

@@ -1,0 +1,225 @@
+"""Issue 52, the hostile cases of round four: one test per fault, each asserting the exit code, the one line and
+that nothing was written (the helpers of tests/test_reliability.py), or the output read back by a second reader
+(csv, an XML parser, ezdxf)."""
+
+from __future__ import annotations
+
+import csv
+import os
+import shutil
+import xml.etree.ElementTree as ET
+
+import ezdxf
+import numpy as np
+import pytest
+
+import patterns
+from patterns.errors import InputError
+
+from .conftest import SAMPLES
+from .test_reliability import refused, run
+
+
+@pytest.fixture
+def strip(tmp_path):
+    """A folder holding the bracket (a bent blank: its bend sheet has rows)."""
+    shutil.copy(SAMPLES / "bracket.step", tmp_path / "strip.step")
+    return tmp_path
+
+
+# --------------------------------------------------------------------------- #
+# 1. CSV injection: every text cell shown, never run
+# --------------------------------------------------------------------------- #
+
+_FORMULA = ("=", "+", "-", "@", "\t", "\r")
+
+
+@pytest.mark.parametrize("stem", ["=cmd|' -C calc'!A0", "+1+1", "-2-3", "@SUM(A1)"])
+def test_a_part_named_like_a_formula_is_a_text_cell_in_the_bend_sheet(strip, capfd, stem):
+    """OWASP's rule, read back with the csv module: the part cell is the name after a quote; no text cell starts
+    a formula; the numbers (a negative coordinate too) stay numbers."""
+    shutil.copy(strip / "strip.step", strip / f"{stem}.step")
+    code, out, err = run(["unfold", f"./{stem}.step", "-o", "blank.dxf", "--bend-sheet", "bends.csv"], strip, capfd)
+    assert code == 0, err
+    with open(strip / "bends.csv", newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    header, body = rows[0], rows[1:]
+    assert body and all(row[0] == "'" + stem for row in body)
+    numeric = [k for k, name in enumerate(header) if name not in ("part", "direction")]
+    for row in body:
+        for k, cell in enumerate(row):
+            if k in numeric and cell:
+                float(cell)  # a number, as written
+            else:
+                assert not cell.startswith(_FORMULA), cell
+
+
+def test_spreadsheet_cells():
+    from patterns.text import spreadsheet_cell
+
+    for text in ("=1+1", "+1", "-1", "@A1", "\uff1dSUM(A1)"):
+        assert spreadsheet_cell(text) == "'" + text
+    assert spreadsheet_cell("\tx") == "\\x09x"  # a control character is made visible first: no formula then
+    assert spreadsheet_cell("bracket 2") == "bracket 2" and spreadsheet_cell("a=b") == "a=b"
+
+
+# --------------------------------------------------------------------------- #
+# 4. Outputs that are what they say: an SVG is XML whatever the name; two roles never share a layer
+# --------------------------------------------------------------------------- #
+
+@pytest.mark.parametrize("stem", ["esc\x1b[31mred\x07bell", "form\x0cfeed", "del\x7f", "one\x01",
+                                  os.fsdecode(b"caf\xe9")])
+def test_an_svg_is_well_formed_xml_whatever_the_file_is_called(strip, capfd, stem):
+    """Control characters and bytes that are not UTF-8 in the part's name: the SVG's title shows them as
+    visible escapes, and Python's XML parser reads the file (the same name through flatten too)."""
+    os.rename(os.fsencode(strip / "strip.step"), os.fsencode(strip) + b"/" + os.fsencode(stem) + b".step")
+    name = os.fsencode(stem) + b".step"
+    for command, out in (("unfold", "blank.svg"), ("flatten", "pattern.svg")):
+        code, _, err = run([command, name, "-o", out], strip, capfd)
+        assert code == 0, err
+        root = ET.parse(strip / out).getroot()
+        title = root.find("{http://www.w3.org/2000/svg}title")
+        assert title is not None and patterns.text.printable(stem) in title.text
+        assert not any(ord(c) < 32 and c not in "\t\n\r" for c in (strip / out).read_text(encoding="utf-8"))
+
+
+@pytest.mark.parametrize(("layers", "words"), [
+    ("patterns,cut=bend", "roles cut, bend, bend_up, bend_down would share layer 'bend'"),
+    ("patterns,label=cut", "roles cut, hole, label would share layer 'CUT'"),
+    ("updown,bend_down=STOCK", "roles bend_down, stock would share layer 'STOCK'"),
+    ("solidworks,bend=0", "would share layer '0'"),
+])
+def test_two_roles_a_machine_treats_differently_never_share_a_layer(strip, capfd, layers, words):
+    refused(["unfold", "strip.step", "-o", "blank.dxf", "--layer-map", layers], strip, capfd, words)
+
+
+def test_roles_of_one_kind_may_share_a_layer_in_any_case(strip, capfd):
+    """The outline and the holes are both cut, every bend is bent: ``hole=Cut`` is the CUT layer (declared once,
+    read back), ``updown,bend_up=BEND_DOWN`` both bend lines on one layer."""
+    code, _, err = run(["unfold", "strip.step", "-o", "a.dxf", "--layer-map", "patterns,hole=Cut"], strip, capfd)
+    assert code == 0, err
+    assert [layer.dxf.name.upper() for layer in ezdxf.readfile(strip / "a.dxf").layers].count("CUT") == 1
+    code, _, err = run(["unfold", "strip.step", "-o", "b.dxf", "--layer-map", "updown,bend_up=bend_down"], strip,
+                       capfd)
+    assert code == 0, err
+
+
+@pytest.mark.parametrize("name", ["a<b", "a;b", "a*", "a?", "a|b", "a=b", "a\nb", "a\x1bb", 'a"b'])
+def test_a_layer_name_no_dxf_reader_takes_is_refused(strip, capfd, name):
+    refused(["unfold", "strip.step", "-o", "blank.dxf", "--layer-map", f"patterns,cut={name}"], strip, capfd,
+            "is not a DXF layer name")
+    with pytest.raises(InputError, match="is not a DXF layer name"):
+        patterns.write(patterns.unfold(strip / "strip.step"), strip / "x.dxf", layer_map={"sew": name})
+    assert not (strip / "x.dxf").exists()
+
+
+# --------------------------------------------------------------------------- #
+# 5. Tracebacks: integers past 64 bits, a flat pattern with a NaN
+# --------------------------------------------------------------------------- #
+
+HUGE = "99999999999999999999"
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (["unfold", "strip.step", "-o", "b.dxf", "--nest-seed", HUGE, "--sheet", "400x300"],
+     "--nest-seed must be an integer between 0 and 4294967295, got 99999999999999999999"),
+    (["unfold", "strip.step", "-o", "b.dxf", "--copies", HUGE, "--sheet", "400x300"], "--copies must be an integer"),
+    (["unfold", "strip.step", "-o", "b.dxf", "--quantity", f"strip={HUGE}", "--sheet", "400x300"],
+     "--quantity['strip'] must be an integer"),
+    (["flatten", "strip.step", "-o", "b.dxf", "--max-darts", HUGE], "--max-darts must be an integer"),
+    (["flatten", "strip.step", "-o", "b.dxf", "--max-iterations", HUGE], "--max-iterations must be an integer"),
+    (["unfold", "strip.step", "-o", "b.dxf", "--fixed-face", HUGE], "is not a planar face of the part"),
+    (["batch", ".", "-o", "out", "--jobs", HUGE], "--jobs must be an integer between 1 and 1024"),
+])
+def test_an_integer_past_64_bits_is_refused_in_one_line(strip, capfd, argv, words):
+    refused(argv, strip, capfd, words)
+
+
+def _dxf(path, lines=(), circles=()):
+    doc = ezdxf.new()
+    for a, b in lines:
+        doc.modelspace().add_line(a, b)
+    for centre, radius in circles:
+        doc.modelspace().add_circle(centre, radius)
+    doc.saveas(path)
+
+
+@pytest.mark.parametrize(("what", "words"), [
+    ("nan line", "a LINE (handle"),
+    ("nan circle", "a CIRCLE (handle"),
+    ("there and back", "a contour of fewer than three points"),
+    ("huge", "MB, over the 20 MB a flat pattern to compare with may have"),
+])
+def test_a_flat_pattern_that_is_no_drawing_is_refused(strip, capfd, what, words):
+    nan = float("nan")
+    path = strip / "theirs.dxf"
+    if what == "nan line":
+        _dxf(path, [((0, 0), (100, 0)), ((100, 0), (nan, 50)), ((100, 50), (0, 50)), ((0, 50), (0, 0))])
+    elif what == "nan circle":
+        _dxf(path, [((0, 0), (100, 0)), ((100, 0), (100, 50)), ((100, 50), (0, 0))], [((10, 10), nan)])
+    elif what == "there and back":
+        _dxf(path, [((0, 0), (100, 0)), ((100, 0), (0, 0))])
+    else:
+        _dxf(path, [((0, 0), (100, 0))])
+        with open(path, "ab") as fh:
+            fh.truncate(21_000_000)  # past the cap: refused on its size, before ezdxf reads a byte
+    refused(["unfold", "strip.step", "-o", "b.dxf", "--compare", "theirs.dxf"], strip, capfd, words)
+
+
+def test_open_pieces_chain_as_the_pair_by_pair_search_did():
+    """The contour chaining looks only near each end (a KD-tree) now: a polygon of 2,000 LINEs given in a
+    shuffled order, some reversed, reads back as the polygon (its area, shoelace by hand)."""
+    from patterns.comparison import _chain
+
+    rng = np.random.default_rng(0)
+    angles = np.sort(rng.uniform(0, 2 * np.pi, 2000))
+    radius = 100 + 10 * np.sin(5 * angles)
+    pts = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
+    pieces = [np.array([pts[k], pts[(k + 1) % len(pts)]]) for k in range(len(pts))]
+    pieces = [p[::-1] if k % 3 == 0 else p for k, p in enumerate(pieces)]
+    order = rng.permutation(len(pieces))
+    loops, left = _chain([pieces[k] for k in order], "t.dxf")
+    assert len(loops) == 1 and not left and len(loops[0]) == 2000
+    x, y = loops[0][:, 0], loops[0][:, 1]
+    shoelace = abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2
+    truth = abs(np.dot(pts[:, 0], np.roll(pts[:, 1], -1)) - np.dot(pts[:, 1], np.roll(pts[:, 0], -1))) / 2
+    assert shoelace == pytest.approx(truth, rel=1e-12)
+
+
+# --------------------------------------------------------------------------- #
+# 6. A material table under the size cap is checked in one pass
+# --------------------------------------------------------------------------- #
+
+def _brute_overlap(table, materials, eps):
+    """The pair-by-pair check the STRtree replaced: the first (row, earlier row) of one material overlapping."""
+    for i in range(len(table)):
+        for j in range(i):
+            a, b = table[i], table[j]
+            if materials[i] == materials[j] and min(a[1], b[1]) - max(a[0], b[0]) > eps \
+                    and min(a[3], b[3]) - max(a[2], b[2]) > eps:
+                return j + 2, i + 2
+    return None
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_overlapping_rows_are_found_as_the_pair_by_pair_check_finds_them(tmp_path, seed):
+    """Random tables on a grid (rows that touch at an edge, rows that overlap, two materials): the rows named
+    are those the pair-by-pair loop names, or none when it finds none."""
+    from patterns.sheetmetal.materials import EPS, read_material_table
+
+    rng = np.random.default_rng(seed)
+    n = 150
+    t0 = rng.integers(1, 6, n) * 0.5
+    rt0 = rng.integers(0, 40, n) * 0.5
+    table = np.column_stack([t0, t0 + rng.integers(1, 3, n) * 0.5, rt0, rt0 + rng.integers(1, 3, n) * 0.5,
+                             np.full(n, 0.4)])
+    materials = [f"m{k}" for k in rng.integers(0, 40 if seed % 2 else 200, n)]
+    path = tmp_path / "t.csv"
+    path.write_text("material,thickness_min,thickness_max,rt_min,rt_max,k_factor\n" + "".join(
+        f"{m},{a:g},{b:g},{c:g},{d:g},{k:g}\n" for m, (a, b, c, d, k) in zip(materials, table)))
+    expected = _brute_overlap(table, materials, EPS)
+    if expected is None:
+        read_material_table(path)
+    else:
+        with pytest.raises(InputError, match=f"rows {expected[0]} and {expected[1]} both give"):
+            read_material_table(path)
