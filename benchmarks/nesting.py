@@ -73,8 +73,16 @@ def main(argv=None) -> int:
     parser.add_argument("--old", default="5138836", help="the commit whose bottom-left nester to run beside")
     parser.add_argument("--budget", type=int, nargs="+", default=[10, 30], help="sparrow's time budgets, s")
     parser.add_argument("--no-old", action="store_true", help="leave the previous nester out (it takes a minute)")
+    parser.add_argument("--orders", action="store_true", help="only: spyrrow alone on the 36 pieces in three "
+                                                               "orders, seeds 0-2 (does the order of items matter?)")
     args = parser.parse_args(argv)
     base = parts()
+    if args.orders:
+        print("| seed | four in a row | patterns.layout's order | one item, demand 4 |\n|---|---|---|---|")
+        for seed in range(3):
+            lengths = [sparrow_alone(base, args.budget[0], seed=seed, order=o)[0] for o in ("rows", "layout", "demand")]
+            print(f"| {seed} | " + " | ".join(f"{x:.1f}" for x in lengths) + " |", flush=True)
+        return 0
     combined = Pattern.combined(base)  # the previous nester took one pattern
     four = combined.with_copies([4] * len(combined.panels))
     print(f"36 pieces ({len(combined.panels)} panels x 4), area {sum(f.area for f in four.panels) / 1e6:.3f} m^2; "
@@ -144,27 +152,32 @@ def main(argv=None) -> int:
     return 0
 
 
-def sparrow_alone(base, budget: int) -> tuple:
+def sparrow_alone(base, budget: int, *, seed: int = 0, order: str = "rows") -> tuple:
     """``(strip length used mm, seconds)``: spyrrow itself on the outlines patterns.layout hands it (the 36 pieces
-    on the 1500 mm roll, 10 mm gap, quarter turns), one worker, the same seed, in this process."""
+    on the 1500 mm roll, 10 mm gap, quarter turns), one worker, in this process; ``order``: each piece four
+    times in a row (``rows``), each piece then the copies as layout gives them (``layout``), or each piece
+    one item of demand 4 (``demand``)."""
     import spyrrow
 
     from patterns.nesting import SIMPLIFY, _item_points, _outline
     from patterns.pieces import pieces_of
 
-    pieces = [p for p in pieces_of(base) for _ in range(4)]
-    items = [spyrrow.Item(str(k), [tuple(q) for q in _item_points(_outline(p, 0.0))], demand=1,
-                          allowed_orientations=[0.0, 90.0, 180.0, 270.0]) for k, p in enumerate(pieces)]
+    base_pieces = pieces_of(base)
+    pieces = ([p for p in base_pieces for _ in range(4)] if order == "rows" else
+              [p for _ in range(4) for p in base_pieces] if order == "layout" else list(base_pieces))
+    items = [spyrrow.Item(str(k), [tuple(q) for q in _item_points(_outline(p, 0.0))],
+                          demand=4 if order == "demand" else 1, allowed_orientations=[0.0, 90.0, 180.0, 270.0])
+             for k, p in enumerate(pieces)]
     edge = 10.0 + SIMPLIFY
     instance = spyrrow.StripPackingInstance("alone", strip_height=1500.0 + 2 * edge, items=items)
     config = spyrrow.StripPackingConfig(early_termination=True, total_computation_time=budget,
-                                        min_items_separation=10.0, seed=0, num_workers=1)
+                                        min_items_separation=10.0, seed=seed, num_workers=1)
     start = time.perf_counter()
     solution = instance.solve(config)
     seconds = time.perf_counter() - start
     far = 0.0  # as patterns.layout measures the roll used: to the furthest outline's end, from the roll's start
     for item in solution.placed_items:
-        pts = np.array(items[int(item.id)].shape)
+        pts = np.array(items[int(item.id)].shape)  # a demand-4 item's copies share its id
         turn = np.radians(item.rotation)
         x = pts[:, 0] * np.cos(turn) - pts[:, 1] * np.sin(turn) + item.translation[0]
         far = max(far, float(x.max()))

@@ -20,38 +20,57 @@ The public API, all importable from the top level::
     result = patterns.batch("parts/", "out/", jobs=2)  # a folder of parts: a row each
 """
 
-from . import deprecated  # noqa: F401 - 0.1.0's Pattern.to_dxf, Pattern.layout, Report.to_json: warn, work, go in 0.3.0
-from .audit import CheckOptions, DartReport, PanelReport, Report, SeamReport, check
-from .batching import BatchOptions, BatchResult, Row, batch
-from .blank import Bend, Blank
-from .bundle import Bundle
-from .comparison import BlankComparison, compare_blank, read_flat_pattern
-from .cut import Cut, cut_to_disk
-from .errors import (
-    CadError,
-    ExportError,
-    FlattenError,
-    InputError,
-    LayoutError,
-    MeshTopologyError,
-    PatternsError,
-)
-from .export import WriteOptions, heat_map, preview_dxf, write
-from .findings import Code, Finding, Severity
-from .flattening import METHODS, Flattening, FlattenOptions, flatten, flatten_mesh
-from .flattening.energy import ENERGIES
-from .flattening.seams import Ease, SeamLengths
-from .measure import Distortion, StrainStats, distortion
-from .mesh import Connectivity, validate_mesh
-from .model import Bookkeeping, Model, Panel, Seam, Surface, SurfaceKind
-from .nesting import Layout, NestOptions, layout
-from .pattern import Dart, DartSearch, FlatPanel, FlatSeam, Pattern
-from .pieces import Drawing, Piece, PieceOptions, pieces_of
-from .predicates import Overlap, overlap_verdict
-from .reading import LoadOptions, load, read_cad, read_mesh
-from .sheetmetal import BendTable, UnfoldOptions, read_bend_table, unfold
-from .tessellate import MeshingOptions, mesh_shape, tessellate_face
-from .units import Unit
+import importlib
+import importlib.util
+
+_EXPORTS = {
+    "CheckOptions": "audit", "DartReport": "audit", "PanelReport": "audit", "Report": "audit", "SeamReport": "audit",
+    "check": "audit",
+    "BatchOptions": "batching", "BatchResult": "batching", "Row": "batching", "batch": "batching",
+    "Bend": "blank", "Blank": "blank",
+    "Bundle": "bundle",
+    "BlankComparison": "comparison", "compare_blank": "comparison", "read_flat_pattern": "comparison",
+    "Cut": "cut", "cut_to_disk": "cut",
+    "CadError": "errors", "ExportError": "errors", "FlattenError": "errors", "InputError": "errors",
+    "LayoutError": "errors", "MeshTopologyError": "errors", "PatternsError": "errors",
+    "WriteOptions": "export", "heat_map": "export", "preview_dxf": "export", "write": "export",
+    "Code": "findings", "Finding": "findings", "Severity": "findings",
+    "FlattenOptions": "flattening", "Flattening": "flattening", "METHODS": "flattening", "flatten": "flattening",
+    "flatten_mesh": "flattening",
+    "ENERGIES": "flattening.energy",
+    "Ease": "flattening.seams", "SeamLengths": "flattening.seams",
+    "Distortion": "measure", "StrainStats": "measure", "distortion": "measure",
+    "Connectivity": "mesh", "validate_mesh": "mesh",
+    "Bookkeeping": "model", "Model": "model", "Panel": "model", "Seam": "model", "Surface": "model",
+    "SurfaceKind": "model",
+    "Layout": "nesting", "NestOptions": "nesting", "layout": "nesting",
+    "Dart": "pattern", "DartSearch": "pattern", "FlatPanel": "pattern", "FlatSeam": "pattern", "Pattern": "pattern",
+    "Drawing": "pieces", "Piece": "pieces", "PieceOptions": "pieces", "pieces_of": "pieces",
+    "Overlap": "predicates", "overlap_verdict": "predicates",
+    "LoadOptions": "reading", "load": "reading", "read_cad": "reading", "read_mesh": "reading",
+    "BendTable": "sheetmetal", "UnfoldOptions": "sheetmetal", "read_bend_table": "sheetmetal", "unfold": "sheetmetal",
+    "MeshingOptions": "tessellate", "mesh_shape": "tessellate", "tessellate_face": "tessellate",
+    "Unit": "units",
+}
+"""Each public name and the module it lives in: imported when first used (PEP 562), so that ``patterns --help``
+and a signal handler are up before numpy, scipy and OpenCascade load."""
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        if importlib.util.find_spec(f"{__name__}.{name}") is None:  # a submodule, as ``patterns.audit``
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        return importlib.import_module(f".{name}", __name__)
+    importlib.import_module(".deprecated", __name__)  # 0.1.0's Pattern.to_dxf, ...: warn, work, go in 0.3.0
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list:
+    return sorted(set(globals()) | set(__all__))
+
 
 __version__ = "0.2.0"
 

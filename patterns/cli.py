@@ -35,6 +35,7 @@ import sys
 import time
 from pathlib import Path
 
+from . import signals
 from .errors import InputError, PatternsError, Terminated
 from .terminal import BatchProgress, Progress, Terminal, foreign_home
 from .text import counted
@@ -454,8 +455,8 @@ def _cmd_batch(args) -> int:
     options = from_arguments(BatchOptions, args)
     files, _ = plan_batch(args.folder, args.output, unfold=options.unfold)
     progress = BatchProgress(len(files), quiet=options.quiet)
-    result = batch(files, args.output, bundle=bundle, options=options, on_row=progress.row,
-                   on_start=progress.start)
+    result = batch(args.folder, args.output, bundle=bundle, options=options, on_row=progress.row,
+                   on_start=progress.start)  # the folder: its entries that are no part file listed as skipped
     progress.close()
     table = [("file", "panels", "seams", "strain RMS %", "max %", "seconds", "status")]
     for r in result.rows:
@@ -464,7 +465,8 @@ def _cmd_batch(args) -> int:
                       "-" if r.strain_rms is None else f"{100 * r.strain_rms:.2f}",
                       "-" if r.strain_max is None else f"{100 * r.strain_max:.2f}", f"{r.seconds:.1f}", status))
     _table(table)
-    counts = ", ".join(f"{result.count(s)} {s}" for s in ("ok", "check failed", "failed", "timeout", "lost", "not run")
+    counts = ", ".join(f"{result.count(s)} {s}" for s in ("ok", "check failed", "failed", "timeout", "lost", "not run",
+                                                                     "skipped")
                        if result.count(s))
     written = sum(bool(r.written) for r in result.rows)
     stop = f"{result.stopped}: " if result.stopped else ""
@@ -573,52 +575,55 @@ COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "de
 # --------------------------------------------------------------------------- #
 
 
-def _on_sigterm(signum, frame):
-    raise Terminated()
-
-
 def main(argv=None) -> int:
     """Run the command line; returns the exit code."""
+    restore = signals.install()  # first: a signal during the heavy imports ends the run in one line too
     foreign_home()
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
     argv = [a for a in argv if a != "--debug"]  # anywhere on the line
     saved = sys.stdout, sys.stderr
     sys.stdout, sys.stderr = Terminal(sys.stdout), Terminal(sys.stderr)
-    previous = None
-    try:
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
-    except ValueError:  # not the main thread (a test harness): no handler
-        pass
     try:
         if argv == ["serve"]:  # the engine for a CAD program (docs/worker.md): its standard output is the protocol's
             return _serve()
         args = _parse(argv)
-        return COMMANDS[args.command](args)
-    except PatternsError as exc:
-        if debug:
-            raise
-        print(f"patterns: error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
-    except MemoryError:
-        if debug:
-            raise
-        print("patterns: error: out of memory (the part, or an option, asks for more than this machine has); "
-              "nothing written", file=sys.stderr)
-        return EXIT_INPUT
-    except KeyboardInterrupt:
-        print("patterns: interrupted; nothing written", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except Terminated:
-        print("patterns: terminated; nothing written", file=sys.stderr)
-        return EXIT_TERMINATED
+        code = COMMANDS[args.command](args)
+        signals.check()  # a stop a library swallowed after the last output: still a stop
+        return code
+    except BaseException as exc:  # noqa: BLE001 - each kind is sorted out (and the rest raised) by _ended
+        return _ended(exc, debug)
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        restore()
         sys.stdout.flush()
         sys.stderr.flush()
         sys.stdout, sys.stderr = saved
 
+
+def _ended(exc: BaseException, debug: bool) -> int:
+    """The exit code, and the one line, of a run that raised ``exc``: a signal received (whatever it turned into
+    on its way: an ``ImportError`` of an extension it interrupted, a library's own error) is the stop it was."""
+    stop = signals.received()
+    if stop is not None and not debug:
+        what = "interrupted" if stop == signal.SIGINT else "terminated"
+        n = signals.written()
+        print(f"patterns: {what}; " + (f"{counted(n, 'output')} had been written whole before it" if n
+                                       else "nothing written"), file=sys.stderr)
+        return EXIT_INTERRUPTED if stop == signal.SIGINT else EXIT_TERMINATED
+    if isinstance(exc, PatternsError) and not debug:
+        print(f"patterns: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    if isinstance(exc, MemoryError) and not debug:
+        print("patterns: error: out of memory (the part, or an option, asks for more than this machine has); "
+              "nothing written", file=sys.stderr)
+        return EXIT_INPUT
+    if isinstance(exc, KeyboardInterrupt):
+        print("patterns: interrupted; nothing written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if isinstance(exc, Terminated):
+        print("patterns: terminated; nothing written", file=sys.stderr)
+        return EXIT_TERMINATED
+    raise exc  # SystemExit (--help), a bug: as it came
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -27,6 +27,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from . import signals
 from .errors import ExportError, InputError
 
 __all__ = ["Outputs", "atomic_output", "check_input_file", "child_python", "csv_table", "output_target", "same_file"]
@@ -170,6 +171,7 @@ def atomic_output(path, *, what: str = "file"):
     tmp = _temporary(target, path, what)
     try:
         yield tmp
+        signals.check()  # a Ctrl-C a library swallowed on the way: nothing replaced
         _commit(tmp, target, path, what)
     except BaseException as exc:
         with contextlib.suppress(OSError):
@@ -199,6 +201,7 @@ def _commit(tmp: Path, target: Path, shown, what: str) -> None:
         mode = target.stat().st_mode & 0o7777 if target.exists() else 0o666 & ~_umask()
         os.chmod(tmp, mode)
         os.replace(tmp, target)
+        signals.committed(target)
     except OSError as exc:
         raise ExportError(f"{_show(shown)}: cannot write the {what} ({_reason(exc)})") from None
 
@@ -238,7 +241,9 @@ class Outputs:
     def commit(self) -> None:
         """Rename every staged file onto its target."""
         staged, self._staged = self._staged, []
+        k = 0
         try:
+            signals.check()  # a Ctrl-C a library swallowed on the way (trimesh catches BaseException): none renamed
             for k, (tmp, target, given, what) in enumerate(staged):
                 _commit(tmp, target, given, what)
         except BaseException:

@@ -223,3 +223,119 @@ def test_overlapping_rows_are_found_as_the_pair_by_pair_check_finds_them(tmp_pat
     else:
         with pytest.raises(InputError, match=f"rows {expected[0]} and {expected[1]} both give"):
             read_material_table(path)
+
+
+# --------------------------------------------------------------------------- #
+# 2, 3. A stop wherever it lands: swallowed by a library, during the imports, mid-work
+# --------------------------------------------------------------------------- #
+
+def test_a_stop_a_library_swallowed_still_writes_nothing(tmp_path):
+    """trimesh's loaders catch BaseException: a Ctrl-C raised inside one is dropped there.  Here the same, for
+    real: the signal sent to this process under the command line's handlers, its KeyboardInterrupt caught and
+    dropped as such a library does; the outputs' commit then refuses (KeyboardInterrupt again), and the file
+    that was there is untouched; SIGTERM likewise (Terminated)."""
+    import signal
+
+    from patterns import signals
+    from patterns.errors import Terminated
+    from patterns.files import Outputs, atomic_output
+
+    target = tmp_path / "out.dxf"
+    target.write_text("the user's file\n")
+    for sig, stop in ((signal.SIGINT, KeyboardInterrupt), (signal.SIGTERM, Terminated)):
+        restore = signals.install()
+        try:
+            try:
+                os.kill(os.getpid(), sig)
+                for _ in range(100):  # the handler runs between bytecodes: soon
+                    pass
+            except BaseException:  # noqa: BLE001 - as trimesh's loaders do
+                pass
+            assert signals.received() == sig
+            with pytest.raises(stop), Outputs() as out:
+                out.stage(target).write_text("half a pattern\n")
+                out.stage(tmp_path / "out.json").write_text("{}\n")
+                out.commit()
+            with pytest.raises(stop), atomic_output(target) as tmp:
+                tmp.write_text("half a pattern\n")
+        finally:
+            restore()
+        assert target.read_text() == "the user's file\n"
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["out.dxf"]
+    assert signals.received() is None  # a run over: later library calls are not stopped by it
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_signal_at_any_moment_ends_the_run_in_one_line(strip, sig):
+    """``patterns unfold`` sent the signal at moments from 0.1 s (the heavy imports: numpy, OpenCascade) to the
+    writing: each run either finished (exit 0, its outputs whole; or killed by the signal as Python ends, after
+    them) or ended with 130 / 143 and exactly one line, the earlier out.dxf untouched and nothing else written --
+    never a traceback."""
+    import signal
+    import subprocess
+    import time
+
+    from .test_reliability import EXE, _interruptible, snapshot
+
+    number = getattr(signal, sig)
+    code, word = (130, "interrupted") if number == signal.SIGINT else (143, "terminated")
+    (strip / "out.dxf").write_text("the user's file\n")
+    before = snapshot(strip)
+    stopped = 0
+    for delay in (0.1, 0.3, 0.6, 1.0, 1.6, 2.5, 4.0):
+        proc = subprocess.Popen([str(EXE), "unfold", "strip.step", "-o", "out.dxf", "--report", "out.json",
+                                 "--bend-sheet", "out.csv"], cwd=strip, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True, preexec_fn=_interruptible)
+        time.sleep(delay)
+        proc.send_signal(number)
+        _, err = proc.communicate(timeout=120)
+        if proc.returncode in (0, -number):  # done; or done and exiting when the signal came (Python's own end)
+            assert "Traceback" not in err and (strip / "out.dxf").read_text() != "the user's file\n", (delay, err)
+            assert {p.name for p in strip.iterdir()} == {"out.dxf", "out.json", "out.csv", "strip.step"}
+            for name in ("out.json", "out.csv"):
+                (strip / name).unlink()
+            (strip / "out.dxf").write_text("the user's file\n")
+            continue
+        stopped += 1
+        assert proc.returncode == code, (delay, proc.returncode, err)
+        assert err.strip() == f"patterns: {word}; nothing written", (delay, err)
+        assert snapshot(strip) == before, delay
+    assert stopped >= 3  # the early moments at least (the imports alone take longer than 0.6 s)
+
+
+# --------------------------------------------------------------------------- #
+# 7. batch: every entry its own row
+# --------------------------------------------------------------------------- #
+
+def test_every_entry_of_a_batch_folder_is_its_own_row(tmp_path):
+    """A part that cannot be read (mode 000), one over the 1 GiB limit (sparse), an empty one: each fails alone
+    while the readable parts are unfolded; a folder, a pipe, a device link, a link to nothing and a link loop
+    named like parts are listed as skipped with why; a name with a newline is a part like any other."""
+    from .test_reliability import cmd, no_dac_override
+
+    folder = tmp_path / "in"
+    folder.mkdir()
+    for name in ("a.step", "locked.step", "new\nline.step"):
+        shutil.copy(SAMPLES / "bracket.step", folder / name)
+    (folder / "locked.step").chmod(0)
+    (folder / "empty.step").write_bytes(b"")
+    with open(folder / "huge.step", "wb") as fh:
+        fh.truncate(1_100_000_000)
+    (folder / "dir.step").mkdir()
+    os.mkfifo(folder / "fifo.step")
+    (folder / "null.step").symlink_to("/dev/null")
+    (folder / "broken.step").symlink_to("missing.step")
+    (folder / "loop.step").symlink_to("loop.step")
+    done = cmd(["batch", "in", "-o", "out", "--unfold", "--jobs", "1"], tmp_path, prefix=no_dac_override())
+    assert done.returncode == 2, done.stderr  # three parts failed
+    rows = {line.split()[0]: line for line in done.stdout.splitlines()[1:] if not line.startswith("batch:")}
+    assert "ok" in rows["a.step"] and "ok" in rows["new\\x0aline.step"]
+    assert "failed: " in rows["locked.step"] and "permission denied" in rows["locked.step"]
+    assert "over the limit of 1 GiB" in rows["huge.step"] and "the file is empty" in rows["empty.step"]
+    for name, why in (("dir.step", "a folder"), ("fifo.step", "a pipe (FIFO)"),
+                      ("null.step", "a device, through a symbolic link"), ("broken.step", "a symbolic link to nothing"),
+                      ("loop.step", "a loop of symbolic links")):
+        assert f"skipped: {why}, not a part file" in rows[name], rows[name]
+    assert "2 ok, 3 failed, 5 skipped" in done.stdout
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.dxf", "a.json", "new\nline.dxf", "new\nline.json"]

@@ -40,12 +40,13 @@ from .plan import (
     check_output_folder,
     output_stems,
     plan_batch,
+    skipped_in,
     wanted,
 )
 from .worker import process_part
 
 __all__ = ["STATUSES", "BatchOptions", "BatchResult", "Row", "batch", "check_output_folder", "output_stems",
-           "plan_batch", "process_part"]
+           "plan_batch", "process_part", "skipped_in"]
 
 _TWO_WAYS = {"max_strain": "dart_strain", "gap": "nest_gap"}
 """Keywords that 0.2.0's ``batch`` gave to two records (``max_strain`` the darts' and the check's limit, ``gap`` the
@@ -104,28 +105,41 @@ def batch(files, out, *, bundle: Bundle | None = None, options: BatchOptions | N
     the local workers are fresh interpreters that run only this package
     (:mod:`patterns.batching.local`) and never import the caller's ``__main__``.
     """
+    from ..reading import CAD_SUFFIXES, check_source
+
     opts, bundle = _options(options, bundle, records, keywords)
+    skipped = ()
     if isinstance(files, (str, os.PathLike)) and Path(files).is_dir():
+        skipped = skipped_in(files, unfold=opts.unfold)
         files, stems = plan_batch(files, out, unfold=opts.unfold)
     else:
-        from ..reading import check_source
-
-        files = [check_source(f) for f in ([files] if isinstance(files, (str, os.PathLike)) else files)]
+        files = [Path(f) for f in ([files] if isinstance(files, (str, os.PathLike)) else files)]
         if not files:
             raise InputError("no files to flatten")
         check_output_folder(out)
         stems = output_stems(files)
     out = Path(out)
+    refused = {}  # every file is its own row: one that cannot be read (permissions, size) fails alone
+    for index, path in enumerate(files):
+        try:
+            check_source(path, CAD_SUFFIXES if opts.unfold else None)
+        except InputError as exc:
+            refused[index] = Row(printable(path.name), "failed", str(exc))
+    todo = [i for i in range(len(files)) if i not in refused]
     kinds = wanted(opts)
-    runner = DaskRunner(opts) if opts.scheduler else LocalRunner(opts, len(files))
+    runner = DaskRunner(opts) if opts.scheduler else LocalRunner(opts, max(1, len(todo)))
     if opts.scheduler:
         runner.connect()  # the address, the workers and their patterns checked before any work
     rows = {}
     stopped = ""
+    for index, row in refused.items():
+        rows[index] = row
+        if on_row is not None:
+            on_row(row, len(rows), len(files))
     try:
-        for index, row in runner.run(files, bundle, kinds, on_start):
-            path = files[index]
-            row = _commit(out, stems[path], row)
+        for k, row in runner.run([files[i] for i in todo], bundle, kinds, on_start) if todo else ():
+            index = todo[k]
+            row = _commit(out, stems[files[index]], row)
             rows[index] = row
             if on_row is not None:
                 on_row(row, len(rows), len(files))
@@ -138,7 +152,8 @@ def batch(files, out, *, bundle: Bundle | None = None, options: BatchOptions | N
     for index, path in enumerate(files):
         if index not in rows:
             rows[index] = Row(printable(path.name), "not run", f"the batch was {stopped or 'stopped'} first")
-    return BatchResult(tuple(rows[i] for i in range(len(files))), runner.where, stopped)
+    skipped_rows = tuple(Row(name, "skipped", why) for name, why in skipped)
+    return BatchResult(tuple(rows[i] for i in range(len(files))) + skipped_rows, runner.where, stopped)
 
 
 def _options(options, bundle, records, keywords) -> tuple:

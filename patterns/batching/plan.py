@@ -8,6 +8,7 @@ what every file ends as, a :class:`Row` of a :class:`BatchResult`.
 
 from __future__ import annotations
 
+import errno
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,11 +16,12 @@ from pathlib import Path
 from ..errors import InputError
 from ..options import Options, option
 from ..reading import CAD_SUFFIXES, MESH_SUFFIXES
+from ..text import printable
 
 __all__ = ["STATUSES", "BatchOptions", "BatchResult", "Row", "check_output_folder", "largest_first", "output_stems",
-           "plan_batch", "wanted"]
+           "plan_batch", "skipped_in", "wanted"]
 
-STATUSES = ("ok", "check failed", "failed", "timeout", "lost", "not run")
+STATUSES = ("ok", "check failed", "failed", "timeout", "lost", "not run", "skipped")
 """What a row's status can be."""
 
 
@@ -105,10 +107,11 @@ class BatchResult:
 
     @property
     def exit_code(self) -> int:
-        """0 all ok; 1 some only fail a check; 2 some failed, timed out or were lost; 130/143 stopped."""
+        """0 all ok; 1 some only fail a check; 2 some failed, timed out or were lost; 130/143 stopped (an entry
+        skipped, a folder or a pipe named like a part, is no failure: listed, not counted against the batch)."""
         if self.stopped:
             return 130 if self.stopped == "interrupted" else 143
-        if any(r.status not in ("ok", "check failed") for r in self.rows):
+        if any(r.status not in ("ok", "check failed", "skipped") for r in self.rows):
             return 2
         return 1 if self.count("check failed") else 0
 
@@ -190,6 +193,32 @@ def plan_batch(folder, out, *, unfold: bool = False) -> tuple[list, dict]:
         raise InputError(f"{os.fsdecode(folder)}: no {what} files in this folder")
     check_output_folder(out)
     return files, output_stems(files)
+
+
+def skipped_in(folder, *, unfold: bool = False) -> tuple:
+    """``((name, why), ...)``: the entries of ``folder`` named like a part (a CAD or mesh suffix) that are no file
+    to read -- a folder, a pipe, a device or socket (directly or through a link), a symbolic link to nothing or
+    a loop of them -- each with why it is left out (a batch lists them as ``skipped`` rows, never silently)."""
+    import stat
+
+    kinds = CAD_SUFFIXES if unfold else CAD_SUFFIXES + MESH_SUFFIXES
+    out = []
+    for p in sorted(Path(folder).iterdir()):
+        if p.suffix.lower() not in kinds or p.is_file():
+            continue
+        try:
+            mode = os.stat(p).st_mode
+        except OSError as exc:
+            why = ("a loop of symbolic links" if exc.errno == errno.ELOOP else
+                   "a symbolic link to nothing" if p.is_symlink() else f"cannot be read ({exc.strerror})")
+        else:
+            why = ("a folder" if stat.S_ISDIR(mode) else "a pipe (FIFO)" if stat.S_ISFIFO(mode) else
+                   "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode)
+                   else "not a regular file")
+            if p.is_symlink():
+                why += ", through a symbolic link"
+        out.append((printable(p.name), why + ", not a part file"))
+    return tuple(out)
 
 
 def check_output_folder(out) -> None:

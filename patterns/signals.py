@@ -1,0 +1,77 @@
+"""Ctrl-C and SIGTERM end a run wherever they land, and a run that was asked to stop writes nothing.
+
+The command line (:func:`patterns.cli.main`) installs :func:`install` first thing, before any heavy
+import.  The handler remembers the signal and raises where Python is (``KeyboardInterrupt``, or
+:class:`~patterns.errors.Terminated` for SIGTERM), so that every ``finally`` runs; and because a library
+may catch and drop what it raises there (trimesh's loaders catch ``BaseException``; an extension module
+being imported turns it into ``ImportError``), the outputs' commit asks :func:`check` before it renames a
+single file, and the command line's last word asks :func:`received`: a stop never depends on where Python
+happened to be.
+"""
+
+from __future__ import annotations
+
+import signal
+
+from .errors import Terminated
+
+__all__ = ["check", "committed", "install", "received", "written"]
+
+_RECEIVED: list = []
+"""The signals received since :func:`install`, in order."""
+
+_COMMITTED: list = []
+"""The outputs renamed onto their targets since :func:`install` (:func:`committed`)."""
+
+
+def _handler(signum, frame):
+    _RECEIVED.append(signum)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise Terminated()
+
+
+def install():
+    """Handle SIGINT and SIGTERM as above (forgetting earlier ones; one ignored stays ignored); returns a function that puts back the
+    handlers there were.  Outside the main thread (a test harness, a host's worker thread) nothing is
+    installed and the function does nothing."""
+    _RECEIVED.clear()
+    _COMMITTED.clear()
+    try:
+        # a signal the process was started ignoring stays ignored (nohup, a shell's background job: as Python
+        # itself leaves SIGINT then)
+        previous = {s: signal.signal(s, _handler) for s in (signal.SIGINT, signal.SIGTERM)
+                    if signal.getsignal(s) is not signal.SIG_IGN}
+    except ValueError:  # not the main thread
+        return lambda: None
+
+    def restore():
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        _RECEIVED.clear()  # the run is over: a library call after it is not stopped by it
+
+    return restore
+
+
+def received() -> int | None:
+    """The first signal received since :func:`install` (``signal.SIGINT`` or ``signal.SIGTERM``), or None."""
+    return _RECEIVED[0] if _RECEIVED else None
+
+
+def check() -> None:
+    """Raise again a stop that was received but swallowed on its way (before anything is committed)."""
+    first = received()
+    if first == signal.SIGINT:
+        raise KeyboardInterrupt
+    if first is not None:
+        raise Terminated()
+
+
+def committed(path) -> None:
+    """Note that ``path`` was written (renamed onto its target): a stop after it cannot say "nothing written"."""
+    _COMMITTED.append(path)
+
+
+def written() -> int:
+    """How many outputs were written since :func:`install`."""
+    return len(_COMMITTED)
