@@ -198,7 +198,7 @@ class CheckOptions(Options):
     max_distortion: float | None = option(2.0, "a triangle laid flat at more than this factor of its 3D size in "
                                                "some direction (2: doubled or halved) is grossly distorted; a "
                                                "panel with more than 1 % of its area so is not a usable pattern "
-                                               "(an error; None: not checked)", low=1, low_open=True,
+                                               "(an error; none: not checked)", low=1, low_open=True,
                                           optional=True, metavar="F")
 
 
@@ -277,6 +277,7 @@ def _check_pattern(pattern: Pattern, opts: CheckOptions) -> Report:
         panel_reports.append(report)
         findings += found + _usable(flat, report, opts)
     findings += _overlaps_between(pattern) + _insert_notes(pattern, max_strain) + _gore_notes(pattern, max_strain)
+    findings += _unit_notes(pattern)
     seam_reports = []
     for fs in pattern.seams:
         report, found = _seam_report(pattern, fs, max_seam_mismatch)
@@ -285,6 +286,26 @@ def _check_pattern(pattern: Pattern, opts: CheckOptions) -> Report:
     findings.sort(key=lambda f: _ORDER[f.severity])
     return Report(pattern.name, tuple(panel_reports), tuple(seam_reports), tuple(findings), max_strain,
                   max_seam_mismatch, opts.area_tolerance, opts.max_distortion, pattern.model.bookkeeping)
+
+
+TINY = 1.0
+"""mm: a pattern whose largest panel is smaller than this across gets a :attr:`Code.TINY_PART` note."""
+
+
+def _unit_notes(pattern: Pattern) -> list:
+    """A note when the whole pattern is under :data:`TINY` across: the unit that would make it 10 mm or more
+    (metres, then centimetres, then inches), and how to say it."""
+    if not pattern.panels:
+        return []
+    size = max(float(np.ptp(flat.uv, axis=0).max()) for flat in pattern.panels)
+    if size >= TINY:
+        return []
+    unit = next((u for u, mm in (("m", 1000.0), ("cm", 10.0), ("in", 25.4)) if size * mm >= 10.0), "m")
+    scale = {"m": 1000.0, "cm": 10.0, "in": 25.4}[unit]
+    return [Finding(Code.TINY_PART, Severity.NOTE, (pattern.panels[0].name,), np.zeros((0, 2)), (), None,
+                    f"{pattern.name}: the pattern is {size:.3g} mm across: was it modelled in {unit}? read in {unit} "
+                    f"it is {size * scale:.3g} mm (a mesh's unit: --input-units {unit}, load(..., units={unit!r}); "
+                    f"a CAD file is read in mm)")]
 
 
 def _placed_like(item, drawing: Drawing):
@@ -387,8 +408,8 @@ def _dart_notes(flat, mag, uv, faces) -> list:
         text = f"panel {flat.name}: {cut} to keep the strain within the limit{of}"
     else:
         limit, tried = search.limit, len(search.tries)
-        text = (f"panel {flat.name}: {cut}{of}; the strain limit {limit:.2%} was not met within {search.max_darts} "
-                f"darts ({tried} cuts measured): the best reached is {where}, from {search.before:.2%} "
+        text = (f"panel {flat.name}: {cut}{of}; the strain limit {limit:.2%} was not met within {counted(search.max_darts, 'dart')} "
+                f"({tried} cuts measured): the best reached is {where}, from {search.before:.2%} "
                 f"without darts")
         if search.needed == 0:
             text += ("; the surface has no positive curvature for darts to take out (it is saddle-shaped): "

@@ -21,6 +21,7 @@ import shapely
 from .bendsheet import bend_rows, numbered
 from .curves import Arc, Loop, Motion
 from .findings import Finding, Severity
+from .text import counted
 
 __all__ = ["Bend", "Blank", "Rim"]
 
@@ -224,6 +225,12 @@ class Blank:
         return replace(self, outline=self.outline.moved(motion), holes=tuple(h.moved(motion) for h in self.holes),
                        bends=tuple(b.moved(motion) for b in self.bends), findings=findings,
                        rims=tuple(r.moved(motion) for r in self.rims))
+
+    def __repr__(self) -> str:
+        w, h = self.size
+        return (f"Blank({self.name!r}, {w:.1f} x {h:.1f} mm, {self.thickness:g} mm thick, "
+                f"{counted(len(self.bends), 'bend')}, {counted(len(self.holes), 'hole')}, "
+                f"{'ok' if self.ok else 'not ok'})")
 
     def to_dict(self) -> dict:
         """Size, area, usage, bends and findings, JSON-ready (the report's ``blanks`` entries)."""

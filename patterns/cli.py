@@ -38,7 +38,7 @@ from pathlib import Path
 from . import signals
 from .errors import InputError, PatternsError, Terminated
 from .terminal import BatchProgress, Progress, Terminal, foreign_home
-from .text import counted
+from .text import counted, printable
 
 __all__ = ["main"]
 
@@ -94,7 +94,7 @@ def _parser() -> argparse.ArgumentParser:
 
     def output(p, *, blank=False):
         add_arguments(p.add_argument_group("pieces"), PieceOptions, skip=PATTERN_ONLY if blank else ())
-        add_arguments(p.add_argument_group("output"), WriteOptions, skip=() if blank else ("units",))
+        add_arguments(p.add_argument_group("output"), WriteOptions)
         add_arguments(p.add_argument_group("nesting (sparrow)"), NestOptions)
 
     flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, .svg, or .obj for one panel)")
@@ -111,11 +111,15 @@ def _parser() -> argparse.ArgumentParser:
     chk = sub.add_parser("check", help="flatten a part and report strain, seams and overlaps (no pattern file)")
     chk.add_argument("--heat-map", type=Path, default=None, help="strain heat map (.png or .svg)")
     loading(chk)
+    chk.add_argument("--units", choices=("mm", "cm", "m", "in"), default=None,
+                     help="deprecated (goes in 0.3.0): --input-units")
     flattening(chk)
     checking(chk)
 
     info = sub.add_parser("info", help="list a part's panels, seams and areas (no flattening)")
     loading(info)
+    info.add_argument("--units", choices=("mm", "cm", "m", "in"), default=None,
+                      help="deprecated (goes in 0.3.0): --input-units")
 
     demo = sub.add_parser("demo", help="run the whole pipeline on a bundled sample into ./patterns-demo/")
     demo.add_argument("-o", "--output", type=Path, default=Path("patterns-demo"), help="folder (default ./patterns-demo)")
@@ -171,6 +175,24 @@ def _host_commands(sub) -> None:
                               "instead")
 
 
+def _answered_early(argv) -> int | None:
+    """``--version`` and a mistyped command, answered before the parser (and the engine it declares) is
+    imported: in a few hundredths of a second, not the seconds numpy, scipy and OpenCascade take."""
+    import difflib
+
+    if argv == ["--version"]:
+        from . import __version__
+
+        print(f"patterns {__version__}")
+        return EXIT_OK
+    if argv and not argv[0].startswith("-") and argv[0] not in COMMANDS and argv[0] != "serve":
+        names = [*COMMANDS][:6] + ["serve"] + [*COMMANDS][6:]
+        close = difflib.get_close_matches(argv[0], names, n=1)
+        hint = f" (did you mean {close[0]}?)" if close else ""
+        raise InputError(f"unknown command {printable(argv[0])!r}{hint}; the commands are {', '.join(names)}")
+    return None
+
+
 def _parse(argv) -> argparse.Namespace:
     """The parsed command line; an unknown option is named with the command's closest one ("did you mean
     --seam-allowance?") and the command's own --help, not the list of commands."""
@@ -178,6 +200,7 @@ def _parse(argv) -> argparse.Namespace:
 
     parser = _parser()
     args, extras = parser.parse_known_args(argv)
+    args.given = {a.split("=", 1)[0] for a in argv if a.startswith("--")}  # the flags given (defaults aside)
     if extras:
         command = parser.commands[args.command]
         known = [flag for action in command._actions for flag in action.option_strings]
@@ -194,10 +217,31 @@ def _bundle(args, name=None):
     kind ``load`` (info), ``unfold`` (unfold, batch --unfold) or ``flatten`` (flatten, check, batch)."""
     from .bundle import Bundle
 
+    from .reading import CAD_SUFFIXES
+
+    if args.command in ("info", "check"):  # no drawing: --units is 0.2.0's name of --input-units, until 0.3.0
+        values = {**vars(args), "units": "mm"}
+        if args.units is not None and "--input-units" not in args.given:
+            print(f"note: --units is --input-units for {args.command} (0.2.0's name, kept until 0.3.0)",
+                  file=sys.stderr)
+            values["input_units"] = args.units
+        args = argparse.Namespace(**values)
     if args.command == "info":
         return Bundle.from_arguments("load", args, name=name)
     unfolding = args.command == "unfold" or (args.command == "batch" and args.unfold)
-    return Bundle.from_arguments("unfold" if unfolding else "flatten", args, name=name)
+    bundle = Bundle.from_arguments("unfold" if unfolding else "flatten", args, name=name)
+    if args.command == "check":
+        return bundle
+    if not unfolding and "--units" in args.given and "--input-units" not in args.given and args.units != "mm":
+        # 0.2.0 read --units as a mesh's unit too: kept, with a word, until 0.3.0 (a CAD file is read in mm anyway)
+        from dataclasses import replace
+
+        if args.command == "batch" or Path(args.input).suffix.lower() not in CAD_SUFFIXES:
+            print(f"note: --units is the drawing's unit; a mesh's own is --input-units. As in 0.2.0, this run also "
+                  f"reads the mesh in {args.units} (until 0.3.0: give --input-units {args.units} to keep it)",
+                  file=sys.stderr)
+        bundle = replace(bundle, load=replace(bundle.load, units=args.units))
+    return bundle
 
 
 # --------------------------------------------------------------------------- #
@@ -587,6 +631,9 @@ def main(argv=None) -> int:
     try:
         if argv == ["serve"]:  # the engine for a CAD program (docs/worker.md): its standard output is the protocol's
             return _serve()
+        early = _answered_early(argv)
+        if early is not None:
+            return early
         args = _parse(argv)
         code = COMMANDS[args.command](args)
         signals.check()  # a stop a library swallowed after the last output: still a stop

@@ -2,7 +2,8 @@
 
 Every error a user can cause is a :class:`PatternsError`.  Each class is also the
 builtin exception a Python programmer would expect (``InputError`` is a
-``ValueError``, ``ExportError`` an ``OSError``), so ``except ValueError`` keeps
+``ValueError``, ``MissingFileError`` also a ``FileNotFoundError``, ``ExportError`` an
+``OSError``), so ``except ValueError`` keeps
 working in code that does not know about `patterns`.
 
 Geometry findings (strain over a limit, an overlap) are *not* exceptions: they are
@@ -18,6 +19,7 @@ __all__ = [
     "InputError",
     "LayoutError",
     "MeshTopologyError",
+    "MissingFileError",
     "PatternsError",
     "Terminated",
 ]
@@ -35,6 +37,11 @@ class InputError(PatternsError, ValueError):
 class MeshTopologyError(InputError):
     """A mesh whose topology cannot be flattened as given: closed, non-manifold,
     several pieces, inconsistently wound, or not a planar domain."""
+
+
+class MissingFileError(InputError, FileNotFoundError):
+    """An input file that is not there: also the ``FileNotFoundError`` Python code expects (and, as every
+    bad input, a ``ValueError``)."""
 
 
 class CadError(PatternsError):

@@ -28,7 +28,7 @@ import tempfile
 from pathlib import Path
 
 from . import signals
-from .errors import ExportError, InputError
+from .errors import ExportError, InputError, MissingFileError
 
 __all__ = ["Outputs", "atomic_output", "check_input_file", "child_python", "csv_table", "output_target", "same_file"]
 
@@ -281,7 +281,7 @@ def check_input_file(path, *, what: str = "file") -> Path:
     try:
         info = os.stat(path)
     except FileNotFoundError:
-        raise InputError(f"{shown}: no such file") from None
+        raise MissingFileError(f"{shown}: no such file") from None
     except OSError as exc:
         raise InputError(f"{shown}: cannot read the {what} ({_reason(exc)})") from None
     if stat.S_ISDIR(info.st_mode):

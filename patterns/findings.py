@@ -77,6 +77,9 @@ class Code(str, Enum):
     """A flange of a blank too short to rest on the shoulder of a 6 t V-die through the bend."""
     MISSING_RELIEF = "missing-relief"
     """A bend that ends against unbent material of its blank with no relief cut there: the corner tears."""
+    TINY_PART = "tiny-part"
+    """A pattern less than a millimetre across: most likely a mesh modelled in metres (or centimetres, inches)
+    read as millimetres; the note names the unit that gives it a likely size and the option that says it."""
     OPEN_CONTOUR = "open-contour"
     """A cut contour of a blank that does not close: an error, a cutter must never get one."""
 

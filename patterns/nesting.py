@@ -120,8 +120,8 @@ class NestOptions(Options):
     copies: int = option(1, "pieces of every panel or blank (a part cut this many times; 2000 pieces a nest at "
                             "most)", integer=True, low=1, high=MAX_PIECES, metavar="N")
     mirror: bool = option(False, "each piece also as its mirror image (left and right)")
-    quantities: dict | None = option(None, "pieces of named panels or blanks, over copies (API: {'sleeve': 2}; "
-                                           "command line NAME=N, repeatable)", check=_quantities, parse=_parse_quantity,
+    quantities: dict | None = option(None, "pieces of named panels or blanks, over copies: NAME=N, repeatable (API: "
+                                           "a mapping of names to counts)", check=_quantities, parse=_parse_quantity,
                                      repeat=True, flag="--quantity", metavar="NAME=N")
     time_limit: int = option(10, "seconds the nest takes (sparrow's search, on a roll or all the sheets, plus its "
                                  "set-up); longer may save a little material",
@@ -224,6 +224,21 @@ class Layout:
     def efficiency(self) -> float:
         """Share of the used material that ends up in pieces (0..1)."""
         return self.area_panels / self.area_used if self.area_used > 0 else 0.0
+
+    def __repr__(self) -> str:
+        return f"Layout({self.name!r}, {len(self.pieces)} pieces, {self})"
+
+    def to_dict(self) -> dict:
+        """What was nested and what it cost, JSON-ready: each piece's name and placement, the stock, the sheets."""
+        return {"name": self.name, "width_mm": self.width, "length_mm": round(self.length, 3),
+                "area_used_mm2": round(self.area_used, 3), "area_pieces_mm2": round(self.area_panels, 3),
+                "efficiency": round(self.efficiency, 6), "seconds": round(self.seconds, 3), "cached": self.cached,
+                "stock": [list(map(float, r)) for r in self.stock],
+                "sheets": [{"index": s.index, "size_mm": list(s.size), "pieces": list(s.pieces),
+                            "usage": round(s.usage, 6)} for s in self.sheets],
+                "pieces": [{"name": p.name, "angle_deg": round(float(np.degrees(p.placement.angle)), 6),
+                            "dx_mm": round(float(p.placement.dx), 6), "dy_mm": round(float(p.placement.dy), 6),
+                            "mirrored": bool(p.placement.mirrored)} for p in self.pieces]}
 
     def drawing(self) -> Drawing:
         """The nest as a drawing: pieces and stock moved together into the first quadrant (the frame every

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from .cut import chains, components, crease_regions, cut_along, cut_to_disk, is_closed, shared_chains
-from .errors import CadError, InputError, MeshTopologyError
+from .errors import CadError, InputError, MeshTopologyError, MissingFileError
 from .files import check_input_file
 from .mesh import MAX_TRIANGLES, as_mesh_arrays, check_faces_have_area, drop_unused, polyline_length, unique_ints
 from .model import Bookkeeping, Model, Seam, panel_from_mesh
@@ -370,8 +370,8 @@ class LoadOptions(MeshingOptions):
                                               "count is in Model.bookkeeping)", check=_weld, parse=_yes_no,
                                         metavar="yes|no", optional=True)
     units: str = option("mm", "mesh files: the unit of the coordinates, converted to mm (CAD files are read in "
-                              "mm whatever this says); on the command line also the unit of the DXF",
-                        choices=UNIT_NAMES)
+                              "mm whatever this says; the drawing's unit is --units)",
+                        choices=UNIT_NAMES, flag="--input-units")
     crease_angle: float = option(60.0, "mesh files: a closed piece (a box, a can) is split into panels along the "
                                        "edges whose faces meet at more than this angle, degrees; a closed piece "
                                        "with no such edge (a sphere) is refused", low=0, high=180, low_open=True,
@@ -434,7 +434,7 @@ def load(source, options: LoadOptions | None = None, **keywords):
         if path.is_dir():
             raise InputError(f"{shown}: is a folder; give a CAD or mesh file")
         if not path.exists():
-            raise InputError(f"{shown}: no such file")
+            raise MissingFileError(f"{shown}: no such file")
         raise InputError(f"{shown}: unknown file type {suffix or '(none)'!r}; expected a CAD file "
                          f"({', '.join(CAD_SUFFIXES)}) or a mesh file ({', '.join(MESH_SUFFIXES)})")
     if getattr(source, "wrapped", None) is not None:  # a build123d shape: mesh_shape checks what it wraps

@@ -59,7 +59,7 @@ def test_a_bundle_reads_back_its_json_form(tmp_path):
     table = tmp_path / "bends.csv"
     table.write_text("thickness,radius,angle,deduction\n2,2,90,3.5\n")
     flat = Bundle.of("flatten", {"dart_strain": 0.04, "grain": (0, 0, 1), "ease": [patterns.Ease(1, "a", mm=2.0)],
-                                 "sheet": (2500, 1250), "quantities": {"front": 2}, "units": "cm",
+                                 "sheet": (2500, 1250), "quantities": {"front": 2}, "units": "cm", "input_units": "in",
                                  "layer_map": "solidworks,label=TEXT", "panels": {"top": [0, 1]},
                                  "notch_style": "v", "bend_lines": False, "weld_vertices": True})
     blank = Bundle.of("unfold", {"bend_table": str(table), "fixed_face": 3, "corner_relief": "round"})
@@ -70,7 +70,7 @@ def test_a_bundle_reads_back_its_json_form(tmp_path):
         assert Bundle.from_json(bundle.kind, json.loads(json.dumps(text))).to_json() == text
     assert flat.to_json()["ease"] == ["1:a:2.0"] and flat.to_json()["sheet"] == [2500.0, 1250.0]
     assert blank.to_json()["bend_table"] == str(table)
-    assert (flat.load.units, flat.write.units) == ("cm", "cm")  # one flag, two records
+    assert (flat.load.units, flat.write.units) == ("in", "cm")  # a mesh's unit, the drawing's: two names
     assert Bundle.from_json("flatten", {"sheet": "2500x1250", "ease": "1:a:2;2:b:5%"}).flatten.ease[1].ratio == 0.05
 
 

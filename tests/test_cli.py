@@ -208,7 +208,7 @@ def test_batch_exit_codes(tmp_path):
         (("flatten", SAMPLES / "cup.step", "-o", "x.dxf", "--preview", "x.jpg"), "--preview writes .png or .svg"),
         (("check", "part.xyz"), "part.xyz: unknown file type '.xyz'"),
         (("info", "missing.iges"), "no such file"),
-        (("batch", ".", "-o", "out", "--jobs", "0"), "jobs must be an integer >= 1, got 0"),
+        (("batch", ".", "-o", "out", "--jobs", "0"), "jobs must be an integer between 1 and 1024, got 0"),
     ],
 )
 def test_user_errors_print_one_line_and_exit_2(tmp_path, args, words):

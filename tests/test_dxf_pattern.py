@@ -563,7 +563,7 @@ def test_astm_notches_point_into_the_piece(cup, tmp_path):
 
 @pytest.mark.parametrize("units", ["mm", "cm", "m", "in"])
 def test_other_units_end_to_end(tmp_path, units):
-    """A mesh in inches (or cm, m) read with --units, written in the same unit: the DXF's outline
+    """A mesh in inches (or cm, m) read with --input-units, written in the same unit (--units): the DXF's outline
     area, in that unit squared, is the mesh's own area computed from the file's numbers; the header
     says the unit (INSUNITS 1/4/5/6, MEASUREMENT 0 for inches) and the label says it too."""
     import trimesh
@@ -579,7 +579,7 @@ def test_other_units_end_to_end(tmp_path, units):
     p = file_v[f]
     area_3d = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum()
     out = tmp_path / "tube.dxf"
-    assert cli.main(["flatten", str(mesh_path), "-o", str(out), "--units", units]) == 0
+    assert cli.main(["flatten", str(mesh_path), "-o", str(out), "--input-units", units, "--units", units]) == 0
     doc = read(out)
     assert doc.header["$INSUNITS"] == patterns.Unit(units).insunits
     assert doc.header["$MEASUREMENT"] == (0 if units == "in" else 1)

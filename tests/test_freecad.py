@@ -133,6 +133,8 @@ def test_the_shared_parts_unfold_in_the_document_as_the_api_unfolds_them(tmp_pat
         assert abs(result["area"] - area) <= 0.0005 * area
         assert result["bend_edges"] == len(blank.bends) and result["ok"]
         assert set(result["marks"]) == {"bend_up", "bend_down", "bend", "label"}
+        for way in ("up", "down"):  # each bend's line among the marks of its own way (issue 53: down ones dropped)
+            assert result["mark_edges"][f"bend_{way}"] == sum(b.direction == way for b in blank.bends), (part, way)
 
 
 def test_a_selected_face_of_a_bent_part_is_its_fixed_face(tmp_path):

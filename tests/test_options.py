@@ -100,7 +100,7 @@ CLI_VALUES = [  # (flag and text, record, the API's keyword and value)
     (["--panel", "front=0,1", "--panel", "back=2"], "load", "panels", {"front": [0, 1], "back": [2]}),
     (["--no-sew"], "load", "sew", False),
     (["--weld-vertices", "no"], "load", "weld_vertices", False),
-    (["--units", "in"], "load", "units", "in"),
+    (["--input-units", "in"], "load", "units", "in"),
     (["--units", "in"], "write", "units", "in"),
     (["--method", "isometric"], "flatten", "method", "isometric"),
     (["--no-exact"], "flatten", "exact", False),

@@ -605,7 +605,8 @@ def test_batch_takes_units_report_preview_and_heat_map(tmp_path, capfd):
     parts = tmp_path / "parts"
     parts.mkdir()
     shutil.copy(SAMPLES / "dish.obj", parts / "dish.obj")
-    code, out, err = run(["batch", "parts", "-o", "out", "--units", "in", "--preview", "--heat-map"], tmp_path, capfd)
+    code, out, err = run(["batch", "parts", "-o", "out", "--input-units", "in", "--units", "in", "--preview",
+                          "--heat-map"], tmp_path, capfd)
     assert code == 0, out + err
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["dish.dxf", "dish.json", "dish_heatmap.png",
                                                                     "dish_preview.png"]
@@ -620,7 +621,8 @@ def test_batch_takes_units_report_preview_and_heat_map(tmp_path, capfd):
 
 def test_a_flat_obj_is_written_in_the_unit_asked_and_says_so(here, capfd):
     code, out, _ = run(["flatten", "dish.obj", "-o", "mm.obj"], here, capfd)
-    code_in, out_in, _ = run(["flatten", "dish.obj", "-o", "in.obj", "--units", "in"], here, capfd)
+    code_in, out_in, _ = run(["flatten", "dish.obj", "-o", "in.obj", "--input-units", "in", "--units", "in"], here,
+                             capfd)
     assert code == code_in == 0 and "(flat mesh, z = 0, in in)" in out_in
     mm = trimesh.load(here / "mm.obj", process=False).vertices
     inch = trimesh.load(here / "in.obj", process=False).vertices

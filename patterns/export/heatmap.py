@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import InputError
 from ..files import atomic_output
 from ..options import check_number, check_ratio
+from ..pattern import Pattern
 from ..pieces.drawing import row_offsets
 from ..text import printable
 
@@ -77,6 +78,12 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
         The file cannot be written.
     """
     path = Path(path)
+    if not isinstance(pattern, Pattern):
+        kind = type(pattern).__name__
+        why = ("a blank is unfolded exactly, its strain 0 everywhere: there is nothing to colour (draw it with "
+               "patterns.write(blank, 'blank.svg') or patterns.preview_dxf)" if kind == "Blank" else
+               "give the Pattern patterns.flatten returned")
+        raise InputError(f"{path}: a heat map draws a flattened pattern's strain, not a {kind}; {why}")
     suffix = path.suffix.lower()
     if suffix not in HEAT_MAP_FORMATS:
         raise InputError(f"{path}: heat maps are written as {' or '.join(HEAT_MAP_FORMATS)}, not {suffix or '(none)'!r}")

@@ -36,8 +36,8 @@ class WriteOptions(Options):
                                        "bend sheet, CSV); "
                                        "default from the file's suffix (.dxf: machine); see docs/dxf.md",
                                  check=_profile, optional=True, metavar="NAME")
-    units: str = option("mm", "unit of the drawing (machine profile; ASTM, SVG and JSON are mm); also, on the "
-                              "command line, the unit of a mesh file's coordinates", choices=UNIT_NAMES)
+    units: str = option("mm", "unit of the drawing (machine profile and a flat OBJ; ASTM, SVG and JSON are mm); a "
+                              "mesh file's own unit is --input-units", choices=UNIT_NAMES)
     version: str | None = option(None, "machine profile: DXF version (default R2000; ASTM is R12)",
                                  choices=DXF_VERSIONS, flag="--dxf-version", optional=True)
     layer_map: LayerMap = option(layer_map("patterns"), "machine profile: the layers, a preset (" + ", ".join(PRESETS)

@@ -67,7 +67,9 @@ class _Page:
                     if not out:
                         out.append(f"M {self.xy(start)}")
                     large = 1 if abs(sweep) > np.pi else 0
-                    flag = 1 if sweep > 0 else 0  # counter-clockwise with y up is clockwise on the page
+                    # SVG's sweep flag 1 turns the positive way of the page's y-down axes: clockwise as seen.  The
+                    # page's y-flip keeps what is seen (an arc counter-clockwise with y up is still seen so): 0
+                    flag = 0 if sweep > 0 else 1
                     out.append(f"A {piece.radius:.4f} {piece.radius:.4f} 0 {large} {flag} {self.xy(end)}")
             else:
                 pts = piece.points()

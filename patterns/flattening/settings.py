@@ -142,6 +142,9 @@ class FlattenOptions(Options):
                     raise InputError(f"{label(name)} applies to {label('method')} relaxed only")
             if self.energy != "auto":
                 raise InputError(f"{label('energy')} applies to {label('method')} relaxed only")
+        if self.gores and self.max_strain is None:  # gores are cut at a strain limit: without one, nothing to do
+            raise InputError(f"{label('gores')} cuts a panel into gores where its strain is above "
+                             f"{label('max_strain')}: give that limit too (e.g. {label('max_strain')} 0.03)")
         if self.gores and self.max_gores < 1:
             raise InputError(f"{label('gores')} needs {label('max_gores')} 1 or more")
         if self.ease and self.seams == "free":

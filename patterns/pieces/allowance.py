@@ -1,7 +1,7 @@
 """The seam allowance: a panel's cut line, its seam line offset outwards by each edge's allowance.
 
 The cut line is the seam line offset outwards with shapely: mitred corners
-(mitre limit 4), or squared ones (each side's allowance run straight on past
+(bevelled past ``mitre_limit`` allowances, default 2, as garment CAD limits them), bevelled ones, or squared ones (each side's allowance run straight on past
 the corner); where allowances change along an outline the step is square.
 Holes shrink by their allowance.  Every contour is then cleaned for a cutter:
 points closer than 1e-6 mm merged, straight runs one segment (a point within
@@ -20,10 +20,13 @@ from ..errors import InputError
 __all__ = ["STRAIGHT", "allowance_lookup", "allowance_outline", "snap", "straight_runs"]
 
 
-def allowance_outline(polygon, loops, per_segment, corners):
+def allowance_outline(polygon, loops, per_segment, corners, *, mitre_limit: float = 2.0):
     """The cut outline: the seam line offset outwards by each segment's allowance.
 
-    ``corners="mitre"``: offset lines meet at a point (mitre limit 4).
+    ``corners="mitre"``: offset lines meet at a point, unless it lies further than ``mitre_limit`` allowances
+    from the corner, where the corner is cut square to its bisector at that distance (a gore's tip: a 20 degree
+    tip's mitre is 5.8 allowances long).  ``"bevel"``: every corner so cut one allowance out (the allowance
+    holds everywhere: nothing inside the round corner it would have).
     ``"square"``: at every sharp corner (turning by more than 30 degrees
     towards the material's outside) each side's allowance is run straight on
     past the corner by its own width, so the corner is squared off.
@@ -33,7 +36,10 @@ def allowance_outline(polygon, loops, per_segment, corners):
     base = float(values.min())
     if corners == "square":
         return _square_allowance(polygon, loops, per_segment)
-    cut = polygon.buffer(base, join_style="mitre", mitre_limit=4.0) if base > 0 else polygon
+    # a bevel is the mitre cut square to the corner's bisector one allowance out: the allowance still holds
+    # everywhere (shapely's own bevel joins the two offsets' ends, cutting into it at a sharp corner)
+    limit = 1.0 if corners == "bevel" else mitre_limit
+    cut = polygon.buffer(base, join_style="mitre", mitre_limit=limit) if base > 0 else polygon
     parts = [cut]
     for loop, allow in zip(loops, per_segment):
         if np.all(allow == base):
@@ -53,7 +59,7 @@ def allowance_outline(polygon, loops, per_segment, corners):
             idx = np.arange(s, e + 1) % n
             line = shapely.LineString(loop[idx])
             parts.append(shapely.buffer(line, -a, single_sided=True, join_style="mitre", cap_style="flat",
-                                        mitre_limit=4.0))
+                                        mitre_limit=limit))
     out = shapely.union_all(parts)
     if out.geom_type != "Polygon":
         out = max(getattr(out, "geoms", [out]), key=lambda g: g.area)

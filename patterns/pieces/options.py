@@ -23,7 +23,7 @@ __all__ = ["MAX_MARKS", "MAX_SEAM_ALLOWANCE", "NOTCH_STYLES", "PATTERN_ONLY", "S
 NOTCH_STYLES = ("slit", "v")
 """Notch shapes: a slit across the seam allowance, or a V."""
 
-SEAM_CORNERS = ("mitre", "square")
+SEAM_CORNERS = ("mitre", "bevel", "square")
 """Corners of the seam allowance."""
 
 MAX_SEAM_ALLOWANCE = 1000.0
@@ -52,13 +52,18 @@ class PieceOptions(Options):
     """What is cut and marked on each piece (:func:`patterns.pieces.pieces_of`, :func:`patterns.write`,
     ``patterns flatten -o``)."""
 
-    seam_allowance: float | dict = option(0.0, "seam allowance added outside the seam line, mm: one number for every "
-                                               "edge, or (API) a mapping {seam id: mm, None: mm for every other "
-                                               "edge}; the seam line then goes on SEW (ASTM layer 14)",
+    seam_allowance: float | dict = option(0.0, "seam allowance added outside the seam line, mm, on every edge (API: also "
+                                               "a mapping of seam ids to mm, the key None for every other edge); the "
+                                               "seam line then goes on SEW (ASTM layer 14)",
                                           check=_seam_allowance, parse=float, unit="mm")
     seam_corners: str = option("mitre", "corners of the seam allowance: offset lines meeting at a point (mitre), "
-                                        "or each side's allowance run straight on past the corner (square)",
+                                        "cut straight across at the allowance (bevel), or each side's allowance "
+                                        "run straight on past the corner (square)",
                                choices=SEAM_CORNERS)
+    mitre_limit: float = option(2.0, "a mitred corner reaching further than this many allowances from its seam "
+                                     "line is bevelled there (garment CAD's corner limit; 2 keeps a square "
+                                     "corner's mitre, 1.41, and bevels the tip of a gore)",
+                                low=1.0, high=10.0, metavar="K")
     notch_spacing: float | None = option(None, "matching notches along every seam every this many mm of 3D "
                                                "length, on both panels (default: at the seam ends only)",
                                          low=0, low_open=True, optional=True, unit="mm")
@@ -90,7 +95,7 @@ class PieceOptions(Options):
         return max(a.values(), default=0.0) if isinstance(a, Mapping) else float(a)
 
 
-PATTERN_ONLY = ("seam_allowance", "seam_corners", "notch_spacing", "notch_style", "bend_spacing", "arcs",
+PATTERN_ONLY = ("seam_allowance", "seam_corners", "mitre_limit", "notch_spacing", "notch_style", "bend_spacing", "arcs",
                 "arc_tolerance", "strain_layer")
 """The options only a flattened pattern's pieces have (seams, rulings, fitted arcs, strain): a blank takes the others."""
 

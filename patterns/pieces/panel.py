@@ -81,7 +81,8 @@ def _geometry(pattern: Pattern, index: int, allowance_of, options: PieceOptions)
     has_allowance = any(np.any(a > 0) for a in per_segment)
     polygon = shapely.Polygon(seam_loops[0], seam_loops[1:])
     if has_allowance:
-        cut = allowance_outline(polygon, seam_loops, per_segment, options.seam_corners)
+        cut = allowance_outline(polygon, seam_loops, per_segment, options.seam_corners,
+                                mitre_limit=options.mitre_limit)
         cut_loops = [np.asarray(cut.exterior.coords)[:-1]] + [np.asarray(r.coords)[:-1] for r in cut.interiors]
     else:
         cut_loops = seam_loops

@@ -134,8 +134,8 @@ class MeshingOptions(Options):
                                           "sewing tolerance", low=0, low_open=True, unit="mm")
     angular_tolerance: float = option(0.2, "CAD: largest angle between the normals at the two ends of a "
                                            "triangle edge, radians", low=0, low_open=True, metavar="RAD")
-    panels: dict | None = option(None, "CAD: groups of CAD faces (indices in shape.faces() order) cut as one panel "
-                                  "each, e.g. {'front': [0, 1]}; on the command line NAME=0,1 (repeatable)",
+    panels: dict | None = option(None, "CAD: groups of CAD faces, by their index in shape.faces() order, cut as one "
+                                  "panel each: NAME=0,1, repeatable (API: a mapping of names to face indices)",
                             check=_panel_groups, parse=parse_panel, repeat=True, flag="--panel", metavar="NAME=FACES")
     sew: bool = option(True, "CAD: sew faces that meet along an edge without sharing it (a file of loose "
                              "faces), so that the edge becomes a seam; --no-sew leaves them apart",

@@ -112,6 +112,7 @@ def blank_of(path, k_factor, face=None):
     return {"area": sum(f.Area for f in faces), "faces": len(faces), "holes": sum(len(f.Wires) - 1 for f in faces),
             "bend_edges": len(blank.Shape.Edges) - sum(len(f.Edges) for f in faces), "ok": blank.Ok,
             "marks": sorted(doc.getObject(name).Role for name in blank.Marks), "source": list(blank.Source[1]),
+            "mark_edges": {doc.getObject(name).Role: len(doc.getObject(name).Shape.Edges) for name in blank.Marks},
             "fixed_face": blank.fixed_face, "n_faces": len(shape.Faces)}
 
 
