@@ -277,7 +277,7 @@ def _check_pattern(pattern: Pattern, opts: CheckOptions) -> Report:
         panel_reports.append(report)
         findings += found + _usable(flat, report, opts)
     findings += _overlaps_between(pattern) + _insert_notes(pattern, max_strain) + _gore_notes(pattern, max_strain)
-    findings += _unit_notes(pattern)
+    findings += _unit_notes(pattern) + _sheet_notes(pattern)
     seam_reports = []
     for fs in pattern.seams:
         report, found = _seam_report(pattern, fs, max_seam_mismatch)
@@ -306,6 +306,19 @@ def _unit_notes(pattern: Pattern) -> list:
                     f"{pattern.name}: the pattern is {size:.3g} mm across: was it modelled in {unit}? read in {unit} "
                     f"it is {size * scale:.3g} mm (a mesh's unit: --input-units {unit}, load(..., units={unit!r}); "
                     f"a CAD file is read in mm)")]
+
+
+def _sheet_notes(pattern: Pattern) -> list:
+    """A note when the flattened part is a bent sheet (:func:`patterns.sheetmetal.sheet.bent_sheet`): unfold it."""
+    from .sheetmetal.sheet import bent_sheet
+
+    found = bent_sheet([(p.surface, p.area) for p in pattern.model.panels])
+    if found is None or not pattern.panels:
+        return []
+    t, bends = found
+    return [Finding(Code.SHEET_METAL, Severity.NOTE, (pattern.panels[0].name,), np.zeros((0, 2)), (), None,
+                    f"{pattern.name}: a bent sheet, it seems ({t:.3g} mm, {counted(bends, 'bend')}): flattened, each "
+                    f"face is a loose panel; patterns unfold (patterns.unfold) makes one blank with bend lines")]
 
 
 def _placed_like(item, drawing: Drawing):

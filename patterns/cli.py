@@ -36,13 +36,14 @@ import time
 from pathlib import Path
 
 from . import signals
+from .console import EXIT_CHECK, EXIT_OK, Run, batch_table, label_notes, loaded, nested, print_panels, table, verdict, wrote
 from .errors import InputError, PatternsError, Terminated
 from .terminal import BatchProgress, Progress, Terminal, foreign_home
 from .text import counted, printable
 
 __all__ = ["main"]
 
-EXIT_OK, EXIT_CHECK, EXIT_INPUT = 0, 1, 2
+EXIT_INPUT = 2
 """Exit codes."""
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
 
@@ -216,7 +217,6 @@ def _bundle(args, name=None):
     """The run's :class:`~patterns.bundle.Bundle` from parsed flags, each value checked as the API checks it:
     kind ``load`` (info), ``unfold`` (unfold, batch --unfold) or ``flatten`` (flatten, check, batch)."""
     from .bundle import Bundle
-
     from .reading import CAD_SUFFIXES
 
     if args.command in ("info", "check"):  # no drawing: --units is 0.2.0's name of --input-units, until 0.3.0
@@ -245,110 +245,6 @@ def _bundle(args, name=None):
 
 
 # --------------------------------------------------------------------------- #
-# What the commands print
-# --------------------------------------------------------------------------- #
-
-
-def _print_panels(report):
-    rows = [("panel", "triangles", "area 3D mm2", "area flat mm2", "strain RMS %", "max %", "p95 %", "one-to-one")]
-    for p in report.panels:
-        rows.append((p.name, str(p.n_triangles), f"{p.area_3d:.1f}", f"{p.area_flat:.1f}",
-                     f"{100 * p.strain_rms:.2f}", f"{100 * p.strain_max:.2f}", f"{100 * p.strain_p95:.2f}",
-                     "yes" if p.one_to_one else "NO"))
-    _table(rows)
-    if report.seams:
-        rows = [("seam", "panels", "3D mm", "flat mm (side 0)", "flat mm (side 1)", "mismatch mm", "%")]
-        for s in report.seams:
-            rows.append((str(s.id), f"{s.panels[0]}/{s.panels[1]}", f"{s.length_3d:.2f}",
-                         f"{s.length_flat[0]:.2f}", f"{s.length_flat[1]:.2f}", f"{s.mismatch:+.2f}",
-                         f"{s.mismatch_percent:+.3f}"))
-        _table(rows)
-
-
-def _table(rows):
-    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
-    for r in rows:
-        print("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
-
-
-def _verdict(report, drawing=None) -> int:
-    print(str(report).splitlines()[0])
-    for f in report.findings:
-        print(f"  {f.severity.value}: {f.message}")
-    if drawing is not None:
-        _label_notes(drawing)
-    return EXIT_OK if report.ok else EXIT_CHECK
-
-
-_MOST_NOTES = 10
-"""Label notes printed at most (the report has every one)."""
-
-
-def _label_notes(drawing) -> None:
-    """The labels the file leaves out, one note each (the same the report gives its pieces)."""
-    from .findings import Code
-
-    notes = [f for p in drawing.pieces for f in p.findings if f.code is Code.LABEL_LEFT_OUT]
-    for f in notes[:_MOST_NOTES]:
-        print(f"  {f.severity.value}: {f.message}")
-    if len(notes) > _MOST_NOTES:
-        print(f"  ... and {len(notes) - _MOST_NOTES} more labels left out (the report lists them)")
-
-
-def _loaded(model, seconds):
-    if model.bookkeeping != type(model.bookkeeping)():
-        print(f"{model.name}: {model.bookkeeping}")
-    print(f"{model.name}: {counted(len(model.panels), 'panel')}, {counted(len(model.seams), 'seam')} "
-          f"(target edge {model.max_edge:.3g} mm), loaded in {seconds:.2f} s")
-
-
-def _nested(nest) -> None:
-    """The nest's line: what it is, and where its time went (a search, or a marker kept from an earlier run)."""
-    if nest is None:
-        return
-    if nest.cached:
-        print(f"nested on {nest} (a marker kept from an earlier run with the same pieces and options, "
-              f"{nest.seconds:.1f} s; --no-nest-cache searches anew)")
-    else:
-        print(f"nested on {nest} (sparrow searched {nest.seconds:.1f} s)")
-    for sheet in nest.drawing().sheets():
-        length, width = sheet.size
-        print(f"  sheet {sheet.index + 1} ({length:g} x {width:g} mm): {len(sheet.pieces)} pieces, usage "
-              f"{sheet.usage:.1%}, cut {sheet.cut_length:.1f} mm, {sheet.pierces} pierces, {sheet.bends} bends")
-
-
-def _wrote(result, bundle):
-    for kind, path in result.outputs.items():
-        if kind == "pattern" and path.suffix.lower() == ".dxf":
-            opts = bundle.write
-            print(f"wrote {path} ({opts.profile or 'machine'} profile, {opts.units}, layers {opts.layer_map})")
-            if opts.units in ("cm", "m"):
-                print(f"note: {path} is in {opts.units}: Inkscape's DXF import and dxf2gcode read only mm and inches, "
-                      f"and take it for mm; write mm or in for them")
-        elif kind == "pattern" and path.suffix.lower() == ".svg":
-            print(f"wrote {path} (1:1 in mm: red cut, blue score, black engrave)")
-        elif kind == "pattern":
-            print(f"wrote {path} (flat mesh, z = 0, in {bundle.write.units})")
-        elif kind == "preview" and result.part.preview_dpi is not None and path.suffix.lower() == ".png":
-            dpi = result.part.preview_dpi
-            print(f"wrote {path} (the DXF at 1:1 at {dpi:.3g} dpi"
-                  f"{'' if dpi >= 95.9 else ': lowered to stay under 40 megapixels; it prints at 1:1 at that dpi'})")
-        elif kind == "preview":
-            print(f"wrote {path} (the DXF at 1:1)")
-        else:
-            print(f"wrote {path}")
-    for path in result.part.sheet_files:
-        print(f"wrote {path} (one sheet alone)")
-
-
-class _Run:
-    """A planned run's outputs and what the work gave, for the printing."""
-
-    def __init__(self, outputs, part):
-        self.outputs, self.part = outputs, part
-
-
-# --------------------------------------------------------------------------- #
 # Commands: plan (every check, nothing written), work, commit (all or nothing)
 # --------------------------------------------------------------------------- #
 
@@ -366,11 +262,11 @@ def _run_part(args, outputs: dict, bundle):
     with Outputs(inputs=inputs) as out:
         try:
             part = flatten_part(args.input, bundle, outputs=planned, stage=out.stage, progress=progress,
-                                loaded=_loaded)
+                                loaded=loaded)
         finally:
             progress.close()
         out.commit()
-    return _Run(planned, part)
+    return Run(planned, part)
 
 
 def _cmd_flatten(args) -> int:
@@ -379,18 +275,18 @@ def _cmd_flatten(args) -> int:
                            "preview": args.preview}, bundle)
     part = run.part
     print(f"flattened ({bundle.flatten.method}) in {part.seconds['flatten']:.2f} s (the flattening alone)")
-    _nested(part.nest)
-    _print_panels(part.report)
-    _wrote(run, bundle)
-    return _verdict(part.report, part.drawing if "pattern" in run.outputs else None)
+    nested(part.nest)
+    print_panels(part.report)
+    wrote(run, bundle)
+    return verdict(part.report, part.drawing if "pattern" in run.outputs else None)
 
 
 def _cmd_check(args) -> int:
     bundle = _bundle(args, name=os.fsdecode(args.input))
     run = _run_part(args, {"report": args.report, "heat_map": args.heat_map}, bundle)
-    _print_panels(run.part.report)
-    _wrote(run, bundle)
-    return _verdict(run.part.report)
+    print_panels(run.part.report)
+    wrote(run, bundle)
+    return verdict(run.part.report)
 
 
 def _cmd_info(args) -> int:
@@ -400,18 +296,18 @@ def _cmd_info(args) -> int:
     check_source(args.input)
     start = time.perf_counter()
     model = load(args.input, bundle.load)
-    _loaded(model, time.perf_counter() - start)
+    loaded(model, time.perf_counter() - start)
     rows = [("panel", "CAD faces", "vertices", "triangles", "outline loops", "area mm2")]
     for p in model.panels:
         rows.append((p.name, ",".join(map(str, p.cad_faces)) or "-", str(len(p.vertices)), str(len(p.faces)),
                      str(len(p.loops)), f"{p.area:.1f}"))
-    _table(rows)
+    table(rows)
     if model.seams:
         rows = [("seam", "panels", "CAD edge", "length mm", "points")]
         for s in model.seams:
             rows.append((str(s.id), f"{model.panels[s.panels[0]].name}/{model.panels[s.panels[1]].name}",
                          "-" if s.cad_edge is None else str(s.cad_edge), f"{s.length:.3f}", str(len(s.points))))
-        _table(rows)
+        table(rows)
     print(f"loading: {model.bookkeeping}")
     return EXIT_OK
 
@@ -474,8 +370,8 @@ def _cmd_demo(args) -> int:
         raise
     print(f"patterns demo: {model.name}, a hemisphere in {counted(len(model.panels), 'panel')}, checked against a "
           f"strain limit of {100 * limit:g} % (as --max-strain {limit:g} would)")
-    _print_panels(report)
-    _verdict(report)
+    print_panels(report)
+    verdict(report)
     if any(f.code is Code.STRAIN_ABOVE_LIMIT for f in report.findings):
         worst = max(p.strain_max for p in report.panels)
         gores = shlex.join(["patterns", "flatten", os.fsdecode(out / "cup.step"), "-o", os.fsdecode(out / "cup_gores.dxf"),
@@ -502,13 +398,7 @@ def _cmd_batch(args) -> int:
     result = batch(args.folder, args.output, bundle=bundle, options=options, on_row=progress.row,
                    on_start=progress.start)  # the folder: its entries that are no part file listed as skipped
     progress.close()
-    table = [("file", "panels", "seams", "strain RMS %", "max %", "seconds", "status")]
-    for r in result.rows:
-        status = r.status + (f": {r.reason}" if r.reason else "")
-        table.append((r.file, "-" if r.panels is None else str(r.panels), "-" if r.seams is None else str(r.seams),
-                      "-" if r.strain_rms is None else f"{100 * r.strain_rms:.2f}",
-                      "-" if r.strain_max is None else f"{100 * r.strain_max:.2f}", f"{r.seconds:.1f}", status))
-    _table(table)
+    batch_table(result.rows, unfold=options.unfold)
     counts = ", ".join(f"{result.count(s)} {s}" for s in ("ok", "check failed", "failed", "timeout", "lost", "not run",
                                                                      "skipped")
                        if result.count(s))
@@ -548,11 +438,11 @@ def _cmd_unfold(args) -> int:
     rows += [(str(r.sequence), r.direction, f"{r.angle_deg:.2f}", f"{r.inside_radius_mm:g}", f"{r.bend_length_mm:.2f}",
               "table" if r.k_factor is None else f"{r.k_factor:g}", f"{r.allowance_mm:.4f}") for r in blank.bend_sheet()]
     if blank.bends:
-        _table(rows)
+        table(rows)
     for f in blank.findings:
         print(f"  {f.severity.value}: {f.message}")
     if blank.ok:
-        _label_notes(part.drawing)
+        label_notes(part.drawing)
     c = part.comparison
     if c is not None:
         print(f"against {args.compare}: area {c.area_error:+.4%}, outer perimeter {c.perimeter - c.perimeter_reference:+.3f}"
@@ -561,8 +451,8 @@ def _cmd_unfold(args) -> int:
     if not blank.ok:
         print(f"{', '.join(map(str, planned.values()))}: not written (the blank cannot be cut as it is)")
         return EXIT_CHECK
-    _nested(part.nest)
-    _wrote(_Run(planned, part), bundle)
+    nested(part.nest)
+    wrote(Run(planned, part), bundle)
     return EXIT_OK
 
 

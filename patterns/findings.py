@@ -80,6 +80,9 @@ class Code(str, Enum):
     TINY_PART = "tiny-part"
     """A pattern less than a millimetre across: most likely a mesh modelled in metres (or centimetres, inches)
     read as millimetres; the note names the unit that gives it a likely size and the option that says it."""
+    SHEET_METAL = "sheet-metal"
+    """A CAD part that is a bent sheet (two parallel planes a thickness apart, coaxial cylinders whose radii
+    differ by it) given to ``flatten``: each face comes out a loose panel; ``unfold`` makes one blank."""
     OPEN_CONTOUR = "open-contour"
     """A cut contour of a blank that does not close: an error, a cutter must never get one."""
 

@@ -391,3 +391,37 @@ def test_every_output_flag_of_a_command_writes_its_file(tmp_path, command):
         assert path.is_file() and path.stat().st_size > 0, name
         if name.endswith(".png"):
             assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_bent_sheet_given_to_flatten_gets_a_note_to_unfold_it():
+    """The bracket (2 mm, one bend: what unfold measures) flattened: a sheet-metal note naming its thickness and
+    bends, and unfold; the cup and a thick-walled tube (no planes a thickness apart) get none."""
+    import build123d as bd
+
+    blank = patterns.unfold(SAMPLES / "bracket.step")
+    flat = patterns.flatten(patterns.load(SAMPLES / "bracket.step"))
+    (note,) = [f for f in patterns.check(flat).findings if f.code is patterns.Code.SHEET_METAL]
+    assert f"({blank.thickness:.3g} mm, {len(blank.bends)} bend)" in note.message and "patterns unfold" in note.message
+    for other in (patterns.load(SAMPLES / "cup.step"), patterns.load(bd.Cylinder(50, 100) - bd.Cylinder(48, 100))):
+        assert not [f for f in patterns.check(patterns.flatten(other)).findings
+                    if f.code is patterns.Code.SHEET_METAL]
+
+
+def test_batch_unfold_shows_each_blank_s_thickness_size_and_bends(tmp_path, capsys):
+    """``batch --unfold``'s table: a blank's columns (what unfold measures of the same part), not a pattern's
+    panels and strains."""
+    import shutil
+
+    from patterns.cli import main
+
+    (tmp_path / "in").mkdir()
+    shutil.copy(SAMPLES / "bracket.step", tmp_path / "in" / "bracket.step")
+    assert main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--unfold", "--jobs", "1"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    header = [line for line in lines if line.startswith("file ")][0]
+    assert header.split() == ["file", "thickness", "mm", "size", "mm", "bends", "seconds", "status"]
+    blank = patterns.unfold(SAMPLES / "bracket.step")
+    w, h = blank.size
+    (row,) = [line for line in lines if line.startswith("bracket.step")]
+    assert row.split()[:6] == ["bracket.step", f"{blank.thickness:g}", f"{w:.1f}", "x", f"{h:.1f}",
+                               str(len(blank.bends))]

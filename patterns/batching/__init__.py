@@ -205,4 +205,5 @@ def _commit(out: Path, stem: str, row: dict) -> Row:
             row.update(status="failed", reason=f"cannot write its results: {exc}")
     return Row(file=printable(row["file"]), status=row["status"], reason=printable(row.get("reason", "")),
                panels=row.get("panels"), seams=row.get("seams"), strain_rms=row.get("strain_rms"),
-               strain_max=row.get("strain_max"), seconds=float(row.get("seconds", 0.0)), written=written)
+               strain_max=row.get("strain_max"), seconds=float(row.get("seconds", 0.0)), written=written,
+               thickness=row.get("thickness"), size=row.get("size"), bends=row.get("bends"))

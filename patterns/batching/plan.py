@@ -83,6 +83,12 @@ class Row:
     strain_max: float | None = None
     seconds: float = 0.0
     written: tuple = ()
+    thickness: float | None = None
+    """A blank's (``batch --unfold``): the sheet's thickness, mm."""
+    size: tuple | None = None
+    """A blank's ``(width, height)``, mm."""
+    bends: int | None = None
+    """A blank's bends."""
 
 
 @dataclass(frozen=True)

@@ -85,8 +85,12 @@ def _numbers(part: PartResult) -> dict:
     report = part.report
     if part.model is None:
         meshed = any(f.code is Code.MESHED_FACE for f in report.findings)
+        blank = report.blanks[0] if report.blanks else None
         return {"panels": 1, "seams": 0, "strain_rms": None if meshed else 0.0,
-                "strain_max": None if meshed else 0.0}
+                "strain_max": None if meshed else 0.0,
+                "thickness": None if blank is None else float(blank.thickness),
+                "size": None if blank is None else tuple(round(float(x), 3) for x in blank.size),
+                "bends": None if blank is None else len(blank.bends)}
     return {"panels": len(part.model.panels), "seams": len(part.model.seams),
             "strain_rms": max(p.strain_rms for p in report.panels), "strain_max": max(p.strain_max for p in report.panels)}
 

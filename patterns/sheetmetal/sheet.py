@@ -233,3 +233,32 @@ def _doubly_curved(faces) -> list:
     kinds = {GeomAbs_Sphere: "sphere", GeomAbs_Torus: "torus"}
     found = [(i, kinds.get(BRepAdaptor_Surface(f.face).GetType())) for i, f in enumerate(faces)]
     return [(i, k) for i, k in found if k is not None]
+
+
+def bent_sheet(surfaces) -> tuple | None:
+    """``(thickness mm, bends)`` when a part's faces look like a bent sheet, else None: the largest plane has a
+    parallel one a thickness behind it (under a tenth of its size), and some coaxial cylinders' radii differ by
+    that thickness (a bend's two skins).  ``surfaces``: each face's :class:`patterns.model.Surface` (None for
+    a face of no analytic kind), with its area, as ``(surface, area)``.  A hint for ``flatten`` (each face a
+    loose panel) that ``unfold`` is meant: never a decision of the engine's."""
+    planes = sorted(((s, a) for s, a in surfaces if s is not None and s.kind.value == "plane"), key=lambda p: -p[1])
+    cylinders = [s for s, _ in surfaces if s is not None and s.kind.value == "cylinder"]
+    if not planes or len(cylinders) < 2:
+        return None
+    top, area = planes[0]
+    n = top.axis / np.linalg.norm(top.axis)
+    gaps = [abs(float(np.dot(s.origin - top.origin, n))) for s, _ in planes[1:]
+            if abs(abs(float(np.dot(s.axis / np.linalg.norm(s.axis), n))) - 1.0) < 1e-6]
+    gaps = [g for g in gaps if 1e-3 < g < 0.1 * np.sqrt(area)]
+    if not gaps:
+        return None
+    t = min(gaps)
+    bends = 0
+    for i, a in enumerate(cylinders):
+        axis = a.axis / np.linalg.norm(a.axis)
+        for b in cylinders[i + 1:]:
+            apart = np.cross(b.origin - a.origin, axis)
+            if abs(abs(float(np.dot(b.axis / np.linalg.norm(b.axis), axis))) - 1.0) < 1e-6 \
+                    and np.linalg.norm(apart) < 1e-6 * max(1.0, a.radius) and abs(abs(a.radius - b.radius) - t) < 1e-6 * max(1.0, t):
+                bends += 1
+    return (t, bends) if bends else None
