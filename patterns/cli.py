@@ -36,7 +36,19 @@ import time
 from pathlib import Path
 
 from . import signals
-from .console import EXIT_CHECK, EXIT_OK, Run, batch_table, label_notes, loaded, nested, print_panels, table, verdict, wrote
+from .console import (
+    EXIT_CHECK,
+    EXIT_OK,
+    Run,
+    batch_table,
+    label_notes,
+    loaded,
+    nested,
+    print_panels,
+    table,
+    verdict,
+    wrote,
+)
 from .errors import InputError, PatternsError, Terminated
 from .terminal import BatchProgress, Progress, Terminal, foreign_home
 from .text import counted, printable
@@ -46,6 +58,26 @@ __all__ = ["main"]
 EXIT_INPUT = 2
 """Exit codes."""
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
+
+
+DESCRIPTION = ("Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns, and unfold bent sheet-metal "
+               "parts into blanks.")
+
+COMMAND_HELP = {
+    "flatten": "flatten a part and write its pattern (.dxf, .svg, or .obj for one panel)",
+    "check": "flatten a part and report strain, seams and overlaps (no pattern file)",
+    "info": "list a part's panels, seams and areas (no flattening)",
+    "demo": "run the whole pipeline on a bundled sample into ./patterns-demo/",
+    "unfold": "unfold a bent sheet-metal part into one flat blank with bend lines (.dxf, .svg)",
+    "batch": "flatten (or --unfold) every part in a folder, in parallel",
+    "serve": "run the engine for a CAD program (FreeCAD's workbench): JSON lines on standard input and output "
+             "(docs/worker.md)",
+    "freecad": "put the Patterns workbench into FreeCAD (install), or take it out (uninstall); the engine stays in "
+               "this environment",
+    "blender": "put the Patterns add-on into Blender 4.2+ (install), or take it out (uninstall); the engine stays "
+               "in this environment",
+}
+"""Each command's one line (``patterns --help``, answered without the engine)."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -68,9 +100,7 @@ def _parser() -> argparse.ArgumentParser:
     from .reading import LoadOptions
     from .sheetmetal import UnfoldOptions
 
-    parser = _Parser(prog="patterns",
-                     description="Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns, and unfold "
-                                 "bent sheet-metal parts into blanks.")
+    parser = _Parser(prog="patterns", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"patterns {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors (anywhere on the line)")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
@@ -98,7 +128,7 @@ def _parser() -> argparse.ArgumentParser:
         add_arguments(p.add_argument_group("output"), WriteOptions)
         add_arguments(p.add_argument_group("nesting (sparrow)"), NestOptions)
 
-    flat = sub.add_parser("flatten", help="flatten a part and write its pattern (.dxf, .svg, or .obj for one panel)")
+    flat = sub.add_parser("flatten", help=COMMAND_HELP["flatten"])
     flat.add_argument("-o", "--output", type=Path, required=True,
                       help="output: .dxf (the pattern for a cutter), .svg (1:1 for laser and vinyl cutters) or .obj "
                            "(the flat mesh of a one-panel part)")
@@ -109,7 +139,7 @@ def _parser() -> argparse.ArgumentParser:
     checking(flat)
     output(flat)
 
-    chk = sub.add_parser("check", help="flatten a part and report strain, seams and overlaps (no pattern file)")
+    chk = sub.add_parser("check", help=COMMAND_HELP["check"])
     chk.add_argument("--heat-map", type=Path, default=None, help="strain heat map (.png or .svg)")
     loading(chk)
     chk.add_argument("--units", choices=("mm", "cm", "m", "in"), default=None,
@@ -117,16 +147,15 @@ def _parser() -> argparse.ArgumentParser:
     flattening(chk)
     checking(chk)
 
-    info = sub.add_parser("info", help="list a part's panels, seams and areas (no flattening)")
+    info = sub.add_parser("info", help=COMMAND_HELP["info"])
     loading(info)
     info.add_argument("--units", choices=("mm", "cm", "m", "in"), default=None,
                       help="deprecated (goes in 0.3.0): --input-units")
 
-    demo = sub.add_parser("demo", help="run the whole pipeline on a bundled sample into ./patterns-demo/")
+    demo = sub.add_parser("demo", help=COMMAND_HELP["demo"])
     demo.add_argument("-o", "--output", type=Path, default=Path("patterns-demo"), help="folder (default ./patterns-demo)")
 
-    unf = sub.add_parser("unfold", help="unfold a bent sheet-metal part into one flat blank with bend lines (.dxf, "
-                                        ".svg)")
+    unf = sub.add_parser("unfold", help=COMMAND_HELP["unfold"])
     unf.add_argument("input", type=Path, help="the folded solid: CAD file (.step .stp .brep .iges .igs)")
     unf.add_argument("-o", "--output", type=Path, required=True,
                      help="the blank: .dxf (outline, holes, bend lines, labels) or .svg")
@@ -141,7 +170,7 @@ def _parser() -> argparse.ArgumentParser:
                      help="a flat pattern of the same part from another CAD program: print how far ours lies from it")
     output(unf, blank=True)
 
-    batch = sub.add_parser("batch", help="flatten (or --unfold) every part in a folder, in parallel")
+    batch = sub.add_parser("batch", help=COMMAND_HELP["batch"])
     batch.add_argument("folder", type=Path, help="folder of input files (not searched recursively)")
     batch.add_argument("-o", "--output", type=Path, required=True, help="folder for the patterns and reports")
     add_arguments(batch.add_argument_group("running"), BatchOptions)
@@ -157,16 +186,13 @@ def _parser() -> argparse.ArgumentParser:
 
 def _host_commands(sub) -> None:
     """``serve`` (the engine for a CAD program), ``freecad install|uninstall`` and ``blender install|uninstall``."""
-    sub.add_parser("serve", help="run the engine for a CAD program (FreeCAD's workbench): JSON lines on standard "
-                                 "input and output (docs/worker.md)")
-    host = sub.add_parser("freecad", help="put the Patterns workbench into FreeCAD (install), or take it out "
-                                          "(uninstall); the engine stays in this environment")
+    sub.add_parser("serve", help=COMMAND_HELP["serve"])
+    host = sub.add_parser("freecad", help=COMMAND_HELP["freecad"])
     host.add_argument("action", choices=("install", "uninstall"), help="install or uninstall")
     host.add_argument("--user-dir", type=Path, default=None, metavar="DIR",
                       help="FreeCAD's user data folder (Mod inside; default: $FREECAD_USER_DATA, $FREECAD_USER_HOME, "
                            "or the platform's)")
-    blender = sub.add_parser("blender", help="put the Patterns add-on into Blender 4.2+ (install), or take it out "
-                                             "(uninstall); the engine stays in this environment")
+    blender = sub.add_parser("blender", help=COMMAND_HELP["blender"])
     blender.add_argument("action", choices=("install", "uninstall"), help="install or uninstall")
     blender.add_argument("--target", type=Path, default=None, metavar="DIR",
                          help="the add-ons folder (default: $BLENDER_USER_SCRIPTS/addons, or scripts/addons of every "
@@ -181,13 +207,24 @@ def _answered_early(argv) -> int | None:
     imported: in a few hundredths of a second, not the seconds numpy, scipy and OpenCascade take."""
     import difflib
 
+    if argv in ([], ["-h"], ["--help"]):  # the commands and their lines: no option record needed
+        parser = _Parser(prog="patterns", description=DESCRIPTION)
+        parser.add_argument("--version", action="store_true", help="show the version and exit")
+        parser.add_argument("--debug", action="store_true", help="show tracebacks of errors (anywhere on the line)")
+        sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+        for name, line in COMMAND_HELP.items():
+            sub.add_parser(name, help=line)
+        if not argv:
+            raise InputError(f"give a command ({', '.join(COMMAND_HELP)}); patterns --help lists them")
+        parser.print_help()
+        return EXIT_OK
     if argv == ["--version"]:
         from . import __version__
 
         print(f"patterns {__version__}")
         return EXIT_OK
-    if argv and not argv[0].startswith("-") and argv[0] not in COMMANDS and argv[0] != "serve":
-        names = [*COMMANDS][:6] + ["serve"] + [*COMMANDS][6:]
+    if argv and not argv[0].startswith("-") and argv[0] not in COMMAND_HELP:
+        names = list(COMMAND_HELP)
         close = difflib.get_close_matches(argv[0], names, n=1)
         hint = f" (did you mean {close[0]}?)" if close else ""
         raise InputError(f"unknown command {printable(argv[0])!r}{hint}; the commands are {', '.join(names)}")
