@@ -19,17 +19,31 @@ from .text import escape
 __all__ = ["BatchProgress", "Progress", "Terminal", "foreign_home", "isatty"]
 
 
+LOG_EVERY = 10.0
+"""Seconds between two progress lines in a log (stderr not a terminal): long work says it is moving."""
+
+
 class Progress:
-    """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
+    """A one-line progress bar on stderr when it is a terminal; in a log (CI, nohup, a pipe), a line every
+    :data:`LOG_EVERY` seconds of long work (none for work shorter than that)."""
 
     def __init__(self, label: str, *, stream=None, enabled: bool | None = None):
         self.stream = stream or sys.stderr
         self.enabled = isatty(self.stream) if enabled is None else enabled
         self.label = label
         self._last = -1.0
+        self._start = self._logged = time.monotonic()
 
     def __call__(self, done: int, total: int) -> None:
-        if not self.enabled or total <= 0:
+        if total <= 0:
+            return
+        if not self.enabled:
+            now = time.monotonic()
+            if now - self._logged >= LOG_EVERY and done < total:
+                self._logged = now
+                self.stream.write(f"{self.label}: {100 * min(max(done / total, 0.0), 1.0):.0f}% "
+                                  f"({now - self._start:.0f} s)\n")
+                self.stream.flush()
             return
         frac = min(max(done / total, 0.0), 1.0)
         if frac - self._last < 0.01 and frac < 1.0:

@@ -425,3 +425,43 @@ def test_batch_unfold_shows_each_blank_s_thickness_size_and_bends(tmp_path, caps
     (row,) = [line for line in lines if line.startswith("bracket.step")]
     assert row.split()[:6] == ["bracket.step", f"{blank.thickness:g}", f"{w:.1f}", "x", f"{h:.1f}",
                                str(len(blank.bends))]
+
+
+def test_long_work_reports_progress_in_a_log_too(monkeypatch):
+    """Off a terminal, a line per LOG_EVERY seconds with the share done (none for short work); 0 s here so that
+    every call past the first counts as long."""
+    import io
+
+    from patterns import terminal
+
+    log = io.StringIO()
+    quiet = terminal.Progress("flattening", stream=log, enabled=False)
+    quiet(1, 4)
+    assert log.getvalue() == ""  # short work: nothing
+    monkeypatch.setattr(terminal, "LOG_EVERY", 0.0)
+    progress = terminal.Progress("flattening", stream=log, enabled=False)
+    for done in range(5):
+        progress(done, 4)
+    lines = log.getvalue().splitlines()
+    assert [line.split(" (")[0] for line in lines] == ["flattening: 0%", "flattening: 25%", "flattening: 50%",
+                                                       "flattening: 75%"]
+
+
+def test_each_finding_is_marked_on_the_heat_map_where_its_panel_is_drawn():
+    """The cup in gores at 5 %: every finding with points is marked, each mark inside the outline of its panel as
+    the picture draws it (its uv moved by the picture's offset), the report's points moved the same way."""
+    from patterns.export.heatmap import display_offsets, finding_marks
+
+    pattern = patterns.flatten(patterns.load(SAMPLES / "cup.step"), max_strain=0.05, gores=True)
+    offsets = display_offsets(pattern)
+    assert np.ptp(offsets, axis=0).max() > 0  # the panels are moved apart in the picture
+    findings = [f for f in patterns.check(pattern).findings if len(f.points)]
+    marks = finding_marks(pattern, offsets)
+    assert len(marks) == len(findings) > 0
+    names = [p.name for p in pattern.panels]
+    for (code, at), f in zip(marks, findings):
+        k = names.index(f.panels[0])
+        flat = pattern.panels[k]
+        drawn = shapely.Polygon(flat.uv[flat.loops[0]] + offsets[k]).buffer(1e-6)
+        assert code == f.code.value and all(drawn.contains(shapely.Point(p)) for p in at)
+        np.testing.assert_allclose(at, np.asarray(f.points) + offsets[k])

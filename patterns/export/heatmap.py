@@ -22,7 +22,8 @@ from ..pattern import Pattern
 from ..pieces.drawing import row_offsets
 from ..text import printable
 
-__all__ = ["HEAT_MAP_FORMATS", "SMALLEST_SCALE", "display_offsets", "heat_map", "heat_map_figure", "percent_tick"]
+__all__ = ["HEAT_MAP_FORMATS", "SMALLEST_SCALE", "display_offsets", "finding_marks", "heat_map", "heat_map_figure",
+           "percent_tick"]
 
 HEAT_MAP_FORMATS = (".png", ".svg")
 """File suffixes :func:`heat_map` writes."""
@@ -39,6 +40,19 @@ def display_offsets(pattern, *, gap: float | None = None) -> np.ndarray:
     if pattern.laid_out:
         return np.zeros((len(pattern.panels), 2))
     return row_offsets([np.r_[p.uv.min(axis=0), p.uv.max(axis=0)] for p in pattern.panels], gap=gap)
+
+
+def finding_marks(pattern, offsets) -> list:
+    """``[(code, (k, 2) points mm)]``: each finding of :func:`patterns.check` that has points, moved by its panel's
+    offset in the picture -- the same points the report gives, where the heat map draws that panel."""
+    from ..audit import check
+
+    names = {flat.name: k for k, flat in enumerate(pattern.panels)}
+    out = []
+    for f in check(pattern).findings:
+        if len(f.points) and f.panels and f.panels[0] in names:
+            out.append((f.code.value, np.asarray(f.points, dtype=np.float64) + offsets[names[f.panels[0]]]))
+    return out
 
 
 def percent_tick(scale: float):
@@ -67,6 +81,9 @@ def heat_map(pattern, path, *, max_strain: float | None = None, title: str | Non
         :data:`SMALLEST_SCALE` (0.1 %: a strain-free part's bar reads -0.1 % .. 0 % .. 0.1 %).
     title : str, optional
         Default: the pattern's name with its RMS and largest strain.
+
+    Every finding of :func:`patterns.check` that has points is marked where it is (an ``x`` at each point,
+    numbered, with its code), in the picture's frame: its panel moved as the picture lays it out.
     dpi : float
         PNG resolution, 10 to 1200 (the figure is 10 x 7 inches).
 
@@ -140,6 +157,10 @@ def heat_map_figure(pattern, *, max_strain: float | None = None, title: str | No
             ax.annotate(f"s{seam.id}", mid, fontsize=7, color="darkgreen", ha="center", va="center")
     if segments:
         ax.add_collection(LineCollection(segments, colors="darkgreen", linewidths=1.6, linestyles="dashed"))
+    for k, (code, at) in enumerate(finding_marks(pattern, offsets), start=1):  # where each finding is, as drawn
+        ax.plot(at[:, 0], at[:, 1], "x", color="black", markersize=6, markeredgewidth=1.5)
+        ax.annotate(f"{k} {code}", at[0], xytext=(4, 4), textcoords="offset points", fontsize=7, parse_math=False,
+                    bbox={"boxstyle": "round", "facecolor": "yellow", "alpha": 0.8, "linewidth": 0})
     ax.set_aspect("equal")
     ax.set_xlabel("mm")
     ax.set_ylabel("mm")
