@@ -218,6 +218,8 @@ def _answered_early(argv) -> int | None:
             raise InputError(f"give a command ({', '.join(COMMAND_HELP)}); patterns --help lists them")
         parser.print_help()
         return EXIT_OK
+    if argv and argv[0] in COMMAND_HELP:
+        return _from_index(argv)
     if argv == ["--version"]:
         from . import __version__
 
@@ -228,6 +230,53 @@ def _answered_early(argv) -> int | None:
         close = difflib.get_close_matches(argv[0], names, n=1)
         hint = f" (did you mean {close[0]}?)" if close else ""
         raise InputError(f"unknown command {printable(argv[0])!r}{hint}; the commands are {', '.join(names)}")
+    return None
+
+
+COMMAND_INDEX = Path(__file__).with_name("commands.json")
+"""Each command's flags and its ``--help`` (at 80 columns), made from the full parser by :func:`command_index`
+(``python -m patterns.cli`` writes it; a test checks that it is the parser's): a command's ``--help`` and a
+mistyped flag are answered from it without importing the engine the parser is made from."""
+
+
+def command_index() -> dict:
+    """``{command: {"flags": [...], "help": its --help at 80 columns}}``, from the full parser."""
+    import os
+
+    saved = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = "80"
+    try:
+        commands = _parser().commands
+        return {name: {"flags": sorted({f for a in p._actions for f in a.option_strings}), "help": p.format_help()}
+                for name, p in commands.items()}
+    finally:
+        if saved is None:
+            os.environ.pop("COLUMNS", None)
+        else:
+            os.environ["COLUMNS"] = saved
+
+
+def _from_index(argv) -> int | None:
+    """A command's ``--help``, or the first flag it does not have (with the closest it has), answered from
+    :data:`COMMAND_INDEX`; None when the line is for the parser (or the index is missing)."""
+    import difflib
+    import json
+
+    try:
+        entry = json.loads(COMMAND_INDEX.read_text(encoding="utf-8"))[argv[0]]
+    except (OSError, ValueError, KeyError):
+        return None
+    for word in argv[1:]:
+        if word == "--":
+            break
+        if word in ("-h", "--help"):
+            print(entry["help"], end="")
+            return EXIT_OK
+        flag = word.split("=", 1)[0]
+        if flag.startswith("--") and not any(f.startswith(flag) for f in entry["flags"]):  # argparse takes prefixes
+            close = difflib.get_close_matches(flag, entry["flags"], n=1, cutoff=0.6)
+            raise InputError(f"unknown option {flag}{f'; did you mean {close[0]}?' if close else ''} (patterns "
+                             f"{argv[0]} --help lists the options)")
     return None
 
 
@@ -599,5 +648,8 @@ def _ended(exc: BaseException, debug: bool) -> int:
         return EXIT_TERMINATED
     raise exc  # SystemExit (--help), a bug: as it came
 
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+if __name__ == "__main__":  # pragma: no cover -- python -m patterns.cli: write the command index anew
+    import json as _json
+
+    COMMAND_INDEX.write_text(_json.dumps(command_index(), indent=1, sort_keys=True) + "\n", encoding="utf-8")
+    print(f"wrote {COMMAND_INDEX}")

@@ -465,3 +465,27 @@ def test_each_finding_is_marked_on_the_heat_map_where_its_panel_is_drawn():
         drawn = shapely.Polygon(flat.uv[flat.loops[0]] + offsets[k]).buffer(1e-6)
         assert code == f.code.value and all(drawn.contains(shapely.Point(p)) for p in at)
         np.testing.assert_allclose(at, np.asarray(f.points) + offsets[k])
+
+
+def test_a_command_s_help_and_a_mistyped_flag_answer_without_the_engine():
+    """``patterns flatten --help`` prints what the full parser prints (at 80 columns), and a mistyped flag gets
+    the closest one, both before numpy, scipy, shapely or OpenCascade are imported; the index they come from is
+    the parser's own (python -m patterns.cli writes it anew)."""
+    import json
+
+    from patterns.cli import COMMAND_INDEX, command_index
+
+    assert json.loads(COMMAND_INDEX.read_text(encoding="utf-8")) == command_index()
+    probe = ("import sys\nfrom patterns.cli import main\ncode = main({argv!r})\n"
+             "print('HEAVY', sorted(m for m in ('numpy', 'scipy', 'shapely', 'OCP', 'build123d') if m in sys.modules))\n"
+             "sys.exit(code)")
+    done = subprocess.run([sys.executable, "-c", probe.format(argv=["flatten", "--help"])], capture_output=True,
+                          text=True, env={**__import__("os").environ, "COLUMNS": "80"})
+    assert done.returncode == 0 and done.stdout.endswith("HEAVY []\n")
+    assert done.stdout[:-len("HEAVY []\n")] == command_index()["flatten"]["help"]
+    done = subprocess.run([sys.executable, "-c", probe.format(argv=["flatten", "p.step", "-o", "p.dxf",
+                                                                    "--seam-alowance", "5"])],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "HEAVY []" in done.stdout
+    assert done.stderr.strip() == ("patterns: error: unknown option --seam-alowance; did you mean --seam-allowance? "
+                                   "(patterns flatten --help lists the options)")
