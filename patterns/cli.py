@@ -40,6 +40,7 @@ from .console import (
     EXIT_CHECK,
     EXIT_OK,
     Run,
+    answered_from_index,
     batch_table,
     label_notes,
     loaded,
@@ -219,7 +220,7 @@ def _answered_early(argv) -> int | None:
         parser.print_help()
         return EXIT_OK
     if argv and argv[0] in COMMAND_HELP:
-        return _from_index(argv)
+        return answered_from_index(argv, COMMAND_INDEX)
     if argv == ["--version"]:
         from . import __version__
 
@@ -254,30 +255,6 @@ def command_index() -> dict:
             os.environ.pop("COLUMNS", None)
         else:
             os.environ["COLUMNS"] = saved
-
-
-def _from_index(argv) -> int | None:
-    """A command's ``--help``, or the first flag it does not have (with the closest it has), answered from
-    :data:`COMMAND_INDEX`; None when the line is for the parser (or the index is missing)."""
-    import difflib
-    import json
-
-    try:
-        entry = json.loads(COMMAND_INDEX.read_text(encoding="utf-8"))[argv[0]]
-    except (OSError, ValueError, KeyError):
-        return None
-    for word in argv[1:]:
-        if word == "--":
-            break
-        if word in ("-h", "--help"):
-            print(entry["help"], end="")
-            return EXIT_OK
-        flag = word.split("=", 1)[0]
-        if flag.startswith("--") and not any(f.startswith(flag) for f in entry["flags"]):  # argparse takes prefixes
-            close = difflib.get_close_matches(flag, entry["flags"], n=1, cutoff=0.6)
-            raise InputError(f"unknown option {flag}{f'; did you mean {close[0]}?' if close else ''} (patterns "
-                             f"{argv[0]} --help lists the options)")
-    return None
 
 
 def _parse(argv) -> argparse.Namespace:

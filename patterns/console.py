@@ -3,9 +3,10 @@
 
 from __future__ import annotations
 
+from .errors import InputError
 from .text import counted
 
-__all__ = ["MOST_NOTES", "Run", "batch_table", "label_notes", "loaded", "nested", "print_panels", "table", "verdict", "wrote"]
+__all__ = ["MOST_NOTES", "Run", "answered_from_index", "batch_table", "label_notes", "loaded", "nested", "print_panels", "table", "verdict", "wrote"]
 
 EXIT_OK, EXIT_CHECK = 0, 1
 """The exit codes of a run that ended: every check passed, or some failed (:mod:`patterns.cli` has the rest)."""
@@ -126,3 +127,27 @@ def batch_table(rows, *, unfold: bool) -> None:
                  "-" if r.strain_max is None else f"{100 * r.strain_max:.2f}", f"{r.seconds:.1f}",
                  r.status + (f": {r.reason}" if r.reason else "")) for r in rows]
     table(out)
+
+
+def answered_from_index(argv, index) -> int | None:
+    """A command's ``--help``, or the first flag it does not have (with the closest it has), answered from
+    :data:`patterns.cli.COMMAND_INDEX` (``index``); None when the line is for the parser (or the index is missing)."""
+    import difflib
+    import json
+
+    try:
+        entry = json.loads(index.read_text(encoding="utf-8"))[argv[0]]
+    except (OSError, ValueError, KeyError):
+        return None
+    for word in argv[1:]:
+        if word == "--":
+            break
+        if word in ("-h", "--help"):
+            print(entry["help"], end="")
+            return EXIT_OK
+        flag = word.split("=", 1)[0]
+        if flag.startswith("--") and not any(f.startswith(flag) for f in entry["flags"]):  # argparse takes prefixes
+            close = difflib.get_close_matches(flag, entry["flags"], n=1, cutoff=0.6)
+            raise InputError(f"unknown option {flag}{f'; did you mean {close[0]}?' if close else ''} (patterns "
+                             f"{argv[0]} --help lists the options)")
+    return None
