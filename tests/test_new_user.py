@@ -489,3 +489,18 @@ def test_a_command_s_help_and_a_mistyped_flag_answer_without_the_engine():
     assert done.returncode == 2 and "HEAVY []" in done.stdout
     assert done.stderr.strip() == ("patterns: error: unknown option --seam-alowance; did you mean --seam-allowance? "
                                    "(patterns flatten --help lists the options)")
+
+
+def test_batch_units_keeps_0_2_0_s_meaning_with_a_warning(tmp_path):
+    """``batch(folder, out, units="cm")`` on a mesh: as 0.2.0, the mesh read in cm too (its report's 3D area
+    100 x trimesh's area of the file's numbers), with a DeprecationWarning naming input_units."""
+    import json
+
+    path, area = _cap(tmp_path, 1.0, "cap.stl")
+    (tmp_path / "in").mkdir()
+    path.rename(tmp_path / "in" / "cap.stl")
+    with pytest.warns(DeprecationWarning, match="batch\\(units=\\) sets units and input_units"):
+        result = patterns.batch(tmp_path / "in", tmp_path / "out", units="cm", jobs=1)
+    assert [r.status for r in result.rows] == ["ok"]
+    report = json.loads((tmp_path / "out" / "cap.json").read_text())
+    assert sum(p["area_3d"] for p in report["panels"]) == pytest.approx(100.0 * area, rel=1e-6)

@@ -48,9 +48,10 @@ from .worker import process_part
 __all__ = ["STATUSES", "BatchOptions", "BatchResult", "Row", "batch", "check_output_folder", "output_stems",
            "plan_batch", "process_part", "skipped_in"]
 
-_TWO_WAYS = {"max_strain": "dart_strain", "gap": "nest_gap"}
+_TWO_WAYS = {"max_strain": "dart_strain", "gap": "nest_gap", "units": "input_units"}
 """Keywords that 0.2.0's ``batch`` gave to two records (``max_strain`` the darts' and the check's limit, ``gap`` the
-pieces' and the nester's): they still do, with a warning, until 0.3.0 (then the check's and the pieces' only)."""
+pieces' and the nester's, ``units`` a mesh's and the drawing's): they still do, with a warning, until 0.3.0 (then
+the check's, the pieces' and the drawing's only)."""
 
 
 def batch(files, out, *, bundle: Bundle | None = None, options: BatchOptions | None = None,
