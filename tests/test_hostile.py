@@ -242,6 +242,9 @@ def test_a_stop_a_library_swallowed_still_writes_nothing(tmp_path):
 
     target = tmp_path / "out.dxf"
     target.write_text("the user's file\n")
+    # a shell's background job (.ci/run &, nohup) starts with SIGINT ignored, and install() keeps an ignored
+    # signal ignored: give this process the terminal's default first, as a user's shell does
+    inherited = signal.signal(signal.SIGINT, signal.default_int_handler)
     for sig, stop in ((signal.SIGINT, KeyboardInterrupt), (signal.SIGTERM, Terminated)):
         restore = signals.install()
         try:
@@ -262,6 +265,7 @@ def test_a_stop_a_library_swallowed_still_writes_nothing(tmp_path):
             restore()
         assert target.read_text() == "the user's file\n"
         assert sorted(p.name for p in tmp_path.iterdir()) == ["out.dxf"]
+    signal.signal(signal.SIGINT, inherited)
     assert signals.received() is None  # a run over: later library calls are not stopped by it
 
 
