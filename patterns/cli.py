@@ -574,14 +574,14 @@ COMMANDS = {"flatten": _cmd_flatten, "check": _cmd_check, "info": _cmd_info, "de
 
 def main(argv=None) -> int:
     """Run the command line; returns the exit code."""
-    restore = signals.install()  # first: a signal during the heavy imports ends the run in one line too
-    foreign_home()
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
     argv = [a for a in argv if a != "--debug"]  # anywhere on the line
     saved = sys.stdout, sys.stderr
-    sys.stdout, sys.stderr = Terminal(sys.stdout), Terminal(sys.stderr)
-    try:
+    restore = signals.install()  # first: a signal during the heavy imports ends the run in one line too
+    try:  # from here on a signal, wherever it lands, is the stop it was (_ended)
+        foreign_home()
+        sys.stdout, sys.stderr = Terminal(sys.stdout), Terminal(sys.stderr)
         if argv == ["serve"]:  # the engine for a CAD program (docs/worker.md): its standard output is the protocol's
             return _serve()
         early = _answered_early(argv)
