@@ -287,7 +287,7 @@ def test_a_signal_at_any_moment_ends_the_run_in_one_line(strip, sig):
     (strip / "out.dxf").write_text("the user's file\n")
     before = snapshot(strip)
     stopped = 0
-    for delay in (0.1, 0.3, 0.6, 1.0, 1.6, 2.5, 4.0):
+    for delay in (0.1, 0.3, 0.8, 2.0, 4.0):
         proc = subprocess.Popen([str(EXE), "unfold", "strip.step", "-o", "out.dxf", "--report", "out.json",
                                  "--bend-sheet", "out.csv"], cwd=strip, stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True, preexec_fn=_interruptible)
@@ -305,7 +305,7 @@ def test_a_signal_at_any_moment_ends_the_run_in_one_line(strip, sig):
         assert proc.returncode == code, (delay, proc.returncode, err)
         assert err.strip() == f"patterns: {word}; nothing written", (delay, err)
         assert snapshot(strip) == before, delay
-    assert stopped >= 3  # the early moments at least (the imports alone take longer than 0.6 s)
+    assert stopped >= 3  # the early moments at least (the imports alone take longer than 0.8 s)
 
 
 # --------------------------------------------------------------------------- #
