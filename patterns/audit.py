@@ -300,8 +300,8 @@ def _unit_notes(pattern: Pattern) -> list:
     size = max(float(np.ptp(flat.uv, axis=0).max()) for flat in pattern.panels)
     if size >= TINY:
         return []
-    unit = next((u for u, mm in (("m", 1000.0), ("cm", 10.0), ("in", 25.4)) if size * mm >= 10.0), "m")
-    scale = {"m": 1000.0, "cm": 10.0, "in": 25.4}[unit]
+    unit, scale = next(((u, mm) for u, mm in (("m", 1000.0), ("cm", 10.0), ("in", 25.4)) if size * mm >= 10.0),
+                       ("m", 1000.0))
     return [Finding(Code.TINY_PART, Severity.NOTE, (pattern.panels[0].name,), np.zeros((0, 2)), (), None,
                     f"{pattern.name}: the pattern is {size:.3g} mm across: was it modelled in {unit}? read in {unit} "
                     f"it is {size * scale:.3g} mm (a mesh's unit: --input-units {unit}, load(..., units={unit!r}); "

@@ -53,6 +53,7 @@ from .console import (
 from .errors import InputError, PatternsError, Terminated
 from .terminal import BatchProgress, Progress, Terminal, foreign_home
 from .text import counted, printable
+from .units import UNIT_NAMES
 
 __all__ = ["main"]
 
@@ -143,14 +144,14 @@ def _parser() -> argparse.ArgumentParser:
     chk = sub.add_parser("check", help=COMMAND_HELP["check"])
     chk.add_argument("--heat-map", type=Path, default=None, help="strain heat map (.png or .svg)")
     loading(chk)
-    chk.add_argument("--units", choices=("mm", "cm", "m", "in"), default=None,
+    chk.add_argument("--units", choices=UNIT_NAMES, default=None,
                      help="deprecated (goes in 0.3.0): --input-units")
     flattening(chk)
     checking(chk)
 
     info = sub.add_parser("info", help=COMMAND_HELP["info"])
     loading(info)
-    info.add_argument("--units", choices=("mm", "cm", "m", "in"), default=None,
+    info.add_argument("--units", choices=UNIT_NAMES, default=None,
                       help="deprecated (goes in 0.3.0): --input-units")
 
     demo = sub.add_parser("demo", help=COMMAND_HELP["demo"])

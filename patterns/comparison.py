@@ -136,12 +136,13 @@ MAX_FLAT_PATTERN_BYTES = 20_000_000
 
 def _finite(values) -> bool:
     """Every number among ``values`` (DXF attributes: numbers, vectors, text) finite."""
+    from ezdxf.math import Vec3
+
     for value in values:
         if isinstance(value, float) and not np.isfinite(value):
             return False
-        if isinstance(value, tuple) or type(value).__name__ == "Vec3":
-            if not all(np.isfinite(float(v)) for v in value):
-                return False
+        if isinstance(value, (tuple, Vec3)) and not all(np.isfinite(float(v)) for v in value):
+            return False
     return True
 
 
