@@ -10,7 +10,7 @@ workbench checked out, ``../shared/sheetmetal`` beside the repository)::
     python benchmarks/sheet_metal.py --freecad /tmp/freecad_flat
 
 ``--parts DIR`` runs it on every ``*.step``/``*.stp`` in ``DIR`` instead (the torture set:
-``--parts ../shared/sheetmetal_torture``, then ``benchmarks/torture.py --freecad``); where ``DIR`` holds a
+``--parts tests/data/torture``, then ``benchmarks/torture.py --freecad``); where ``DIR`` holds a
 ``parts.csv`` with ``part`` and ``k_factor`` columns, each part listed there is unfolded with its own K-factor
 (``--k-factor`` is for the rest).
 

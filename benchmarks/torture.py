@@ -4,7 +4,7 @@ Run from the repository root::
 
     python benchmarks/torture.py [--freecad /tmp/torture_freecad]
 
-The parts are ``../shared/sheetmetal_torture/*.step`` (provenance, licence and what each
+The parts are ``tests/data/torture/*.step`` (provenance, licence and what each
 part tests in its ``PROVENANCE.md`` and ``parts.csv``), each unfolded with the K-factor
 ``parts.csv`` gives (0.44 for the Fusion 360 parts: the K-factor their own flat patterns were made with;
 0.5 where the source names none).
@@ -14,7 +14,7 @@ flat pattern Fusion 360 drew for the same part, in the source repository; the pl
 area for a flat plate; else the solid's volume over the thickness, which is the blank's area
 at K = 0.5 and is compared with a second unfold at K = 0.5), and the time of the
 unfold (best of three, from the shape in memory, as FreeCAD's is taken).  With ``--freecad
-DIR`` (the output of ``benchmarks/freecad_sheetmetal.py --parts ../shared/sheetmetal_torture``, each
+DIR`` (the output of ``benchmarks/freecad_sheetmetal.py --parts tests/data/torture``, each
 part at its own K-factor from ``parts.csv``) FreeCAD SheetMetal's result on the same part is set beside ours, measured
 against the same reference.
 """
@@ -33,7 +33,7 @@ from patterns.errors import PatternsError
 from patterns.reading import read_cad
 from patterns.text import counted
 
-TORTURE = Path(__file__).resolve().parent.parent.parent / "shared" / "sheetmetal_torture"
+TORTURE = Path(__file__).resolve().parent.parent / "tests" / "data" / "torture"
 
 
 def parts(folder: Path = TORTURE) -> list:

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import sys
 import time
 from pathlib import Path
@@ -59,7 +58,7 @@ __all__ = ["main"]
 
 EXIT_INPUT = 2
 """Exit codes."""
-EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
+EXIT_INTERRUPTED, EXIT_TERMINATED = signals.EXIT_INTERRUPTED, signals.EXIT_TERMINATED
 
 
 DESCRIPTION = ("Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns, and unfold bent sheet-metal "
@@ -170,6 +169,9 @@ def _parser() -> argparse.ArgumentParser:
                           "them, with direction, angle, radius, length, K-factor, allowance and the line on the DXF")
     unf.add_argument("--compare", type=Path, default=None, metavar="DXF",
                      help="a flat pattern of the same part from another CAD program: print how far ours lies from it")
+    unf.add_argument("--compare-open", choices=("error", "leave-out"), default="error",
+                     help="a contour of the --compare file that does not close: an error naming where (default), or "
+                          "left out of the comparison and counted")
     output(unf, blank=True)
 
     batch = sub.add_parser("batch", help=COMMAND_HELP["batch"])
@@ -487,7 +489,7 @@ def _cmd_unfold(args) -> int:
     planned = plan_outputs({"pattern": args.output, "report": args.report, "preview": args.preview,
                             "bend_sheet": args.bend_sheet}, inputs=inputs,
                            suffixes={"pattern": (".dxf", ".svg")}, profile=bundle.write.profile)
-    reference = read_flat_pattern(args.compare) if args.compare is not None else None
+    reference = read_flat_pattern(args.compare, open_contours=args.compare_open) if args.compare is not None else None
     with Outputs(inputs=inputs) as out:
         part = unfold_part(args.input, bundle, outputs=planned, stage=out.stage, reference=reference)
         if part.subject.ok:
@@ -503,6 +505,8 @@ def _cmd_unfold(args) -> int:
               "table" if r.k_factor is None else f"{r.k_factor:g}", f"{r.allowance_mm:.4f}") for r in blank.bend_sheet()]
     if blank.bends:
         table(rows)
+    elif args.bend_sheet is not None and blank.ok:
+        print(f"  note: {blank.name} has no bends: {args.bend_sheet} has its header only")
     for f in blank.findings:
         print(f"  {f.severity.value}: {f.message}")
     if blank.ok:
@@ -512,6 +516,8 @@ def _cmd_unfold(args) -> int:
         print(f"against {args.compare}: area {c.area_error:+.4%}, outer perimeter {c.perimeter - c.perimeter_reference:+.3f}"
               f" mm, holes {c.holes}/{c.holes_reference}, bend lines {c.bend_lines}/{c.bend_lines_reference}, outline "
               f"Hausdorff {c.hausdorff:.3f} mm ({c.within:.1%} of it within 0.1 mm)")
+        if len(reference.open_contours):
+            print(f"  note: {counted(len(reference.open_contours), 'open contour')} of {args.compare} left out")
     if not blank.ok:
         print(f"{', '.join(map(str, planned.values()))}: not written (the blank cannot be cut as it is)")
         return EXIT_CHECK
@@ -606,11 +612,10 @@ def _ended(exc: BaseException, debug: bool) -> int:
     on its way: an ``ImportError`` of an extension it interrupted, a library's own error) is the stop it was."""
     stop = signals.received()
     if stop is not None and not debug:
-        what = "interrupted" if stop == signal.SIGINT else "terminated"
         n = signals.written()
-        print(f"patterns: {what}; " + (f"{counted(n, 'output')} had been written whole before it" if n
-                                       else "nothing written"), file=sys.stderr)
-        return EXIT_INTERRUPTED if stop == signal.SIGINT else EXIT_TERMINATED
+        print(f"patterns: {signals.stopped(stop)}; " + (f"{counted(n, 'output')} had been written whole before it"
+                                                       if n else "nothing written"), file=sys.stderr)
+        return signals.exit_code(stop)
     if isinstance(exc, PatternsError) and not debug:
         print(f"patterns: error: {exc}", file=sys.stderr)
         return EXIT_INPUT

@@ -15,7 +15,11 @@ import signal
 
 from .errors import Terminated
 
-__all__ = ["check", "committed", "install", "received", "written"]
+__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "check", "committed", "exit_code", "install", "received", "stopped",
+           "written"]
+
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
+"""The exit codes of a run stopped by SIGINT and by SIGTERM (128 + the signal's number, as a shell gives)."""
 
 _RECEIVED: list = []
 """The signals received since :func:`install`, in order."""
@@ -56,6 +60,16 @@ def install():
 def received() -> int | None:
     """The first signal received since :func:`install` (``signal.SIGINT`` or ``signal.SIGTERM``), or None."""
     return _RECEIVED[0] if _RECEIVED else None
+
+
+def stopped(signum: int) -> str:
+    """The word for a stop: ``"interrupted"`` (SIGINT) or ``"terminated"`` (SIGTERM)."""
+    return "interrupted" if signum == signal.SIGINT else "terminated"
+
+
+def exit_code(signum: int) -> int:
+    """:data:`EXIT_INTERRUPTED` for SIGINT, :data:`EXIT_TERMINATED` for SIGTERM."""
+    return EXIT_INTERRUPTED if signum == signal.SIGINT else EXIT_TERMINATED
 
 
 def check() -> None:

@@ -231,3 +231,72 @@ def test_rims_move_with_the_blank(blank):
         for a, b in itertools.zip_longest(blank.rims, moved.rims):
             assert np.allclose(motion(a.center[None, :])[0], b.center, atol=1e-12)
             assert b.circle.sweep > 0 and (a.kind, a.side, a.through) == (b.kind, b.side, b.through)
+
+
+@pytest.mark.parametrize("fixed", ["bored side", "other side", "default"])
+def test_a_counterbore_on_either_side_leaves_the_thickness_alone(fixed):
+    """A 2 mm plate, 100 x 60, with one Ø 6.6 hole counterbored Ø 11 x 1 deep from the top: the counterbore's
+    floor is a face parallel to either skin, 1 mm from the top -- and, from the bottom, nearer than the top
+    skin.  Fixed on either side, the thickness is the plate's 2 mm and the blank the bottom's outline with the
+    through hole (before: 1 mm when the bore was on the far side)."""
+    solid = bd.Box(100, 60, 2) - bd.Cylinder(3.3, 8) - bd.Pos(0, 0, 0) * bd.Cylinder(5.5, 2, align=UP)
+    face = {"bored side": _face(solid, 1.0), "other side": _face(solid, -1.0), "default": None}[fixed]
+    blank = patterns.unfold(solid, fixed_face=face)
+    assert blank.thickness == pytest.approx(2.0, abs=1e-9)
+    assert blank.area == pytest.approx(100 * 60 - np.pi * 3.3 ** 2, abs=2e-3 * 2 * np.pi * 3.3)
+
+
+def test_compare_takes_a_flat_pattern_with_an_open_contour_when_asked(tmp_path):
+    """``--compare`` refuses a DXF with an open contour in one line (exit 2, nothing written) unless
+    ``--compare-open leave-out``: then it compares and says how many it left out.  A blank with no bends
+    says its bend sheet has the header only (and the CSV read back has no row)."""
+    import csv
+
+    from patterns.cli import main
+
+    bd.export_step(bd.Box(100, 60, 2) - bd.Pos(-30, -10, 0) * bd.Cylinder(4, 4), str(tmp_path / "plate.step"))
+    theirs = _drawing(tmp_path / "theirs.dxf", circles=[(20, 20, 4.0)], arcs=[(70, 30, 2.0, 0.0, 90.0)])
+    argv = ["unfold", str(tmp_path / "plate.step"), "-o", str(tmp_path / "ours.dxf"), "--compare", str(theirs),
+            "--bend-sheet", str(tmp_path / "bends.csv")]
+    assert main(argv) == 2
+    assert not (tmp_path / "ours.dxf").exists() and not (tmp_path / "bends.csv").exists()
+    assert main(argv + ["--compare-open", "leave-out"]) == 0
+    with open(tmp_path / "bends.csv", newline="") as f:
+        assert len(list(csv.reader(f))) == 1
+    assert (tmp_path / "ours.dxf").is_file()
+
+
+def test_compare_open_notes(tmp_path, capsys):
+    from patterns.cli import main
+
+    bd.export_step(bd.Box(100, 60, 2), str(tmp_path / "plate.step"))
+    theirs = _drawing(tmp_path / "theirs.dxf", circles=[], arcs=[(70, 30, 2.0, 0.0, 90.0)])
+    assert main(["unfold", str(tmp_path / "plate.step"), "-o", str(tmp_path / "ours.dxf"), "--compare", str(theirs),
+                 "--compare-open", "leave-out", "--bend-sheet", str(tmp_path / "b.csv")]) == 0
+    out = capsys.readouterr().out
+    assert f"note: 1 open contour of {theirs} left out" in out
+    assert f"note: plate has no bends: {tmp_path / 'b.csv'} has its header only" in out
+
+
+def test_a_plate_of_many_holes_is_read_and_unfolded_whole(tmp_path):
+    """A 2 mm plate with 30 x 30 Ø 5 holes (906 faces), written as STEP and read back: every hole is cut, at
+    its place and size, and the blank's area is the square's less the holes' (exact arcs).  The reader's
+    lighter repairs, the holes' KD-tree and the labels' margin test all meet it (benchmarks/plate_faces.py
+    times the larger plates)."""
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+
+    from patterns.samples import holed_plate
+
+    writer = STEPControl_Writer()
+    writer.Transfer(holed_plate(30), STEPControl_AsIs)
+    writer.Write(str(tmp_path / "plate.step"))
+    blank = patterns.unfold(tmp_path / "plate.step")
+    assert (blank.thickness, len(blank.holes), len(blank.bends)) == (2.0, 900, 0)
+    assert blank.area == pytest.approx(300 ** 2 - 900 * np.pi * 2.5 ** 2, rel=1e-9)
+    centres = np.array([hole.pieces[0].center for hole in blank.holes])
+    centres -= centres.min(axis=0)
+    grid = np.round(centres / 10.0, 9)
+    assert sorted(map(tuple, grid)) == [(float(i), float(j)) for i in range(30) for j in range(30)]
+    assert all(hole.pieces[0].radius == pytest.approx(2.5, abs=1e-9) for hole in blank.holes)
+    patterns.write(blank, tmp_path / "plate.dxf")
+    assert len(ezdxf.readfile(tmp_path / "plate.dxf").modelspace().query("CIRCLE[layer=='CUT']")) == 900

@@ -274,8 +274,8 @@ def test_a_stop_a_library_swallowed_still_writes_nothing(tmp_path):
 def test_a_signal_at_any_moment_ends_the_run_in_one_line(strip, sig):
     """``patterns unfold`` sent the signal at moments from 0.1 s (the heavy imports: numpy, OpenCascade) to the
     writing: each run either finished (exit 0, its outputs whole; or killed by the signal as Python ends, after
-    them) or ended with 130 / 143 and exactly one line, the earlier out.dxf untouched and nothing else written --
-    never a traceback."""
+    them), or was killed silently as the interpreter started (before any handler: nothing written), or ended with
+    130 / 143 and exactly one line, the earlier out.dxf untouched and nothing else written -- never a traceback."""
     import signal
     import subprocess
     import time
@@ -294,6 +294,8 @@ def test_a_signal_at_any_moment_ends_the_run_in_one_line(strip, sig):
         time.sleep(delay)
         proc.send_signal(number)
         _, err = proc.communicate(timeout=120)
+        if proc.returncode == -number and not err and snapshot(strip) == before:
+            continue  # killed by the signal as the interpreter started, before any handler (nothing written)
         if proc.returncode in (0, -number):  # done; or done and exiting when the signal came (Python's own end)
             assert "Traceback" not in err and (strip / "out.dxf").read_text() != "the user's file\n", (delay, err)
             assert {p.name for p in strip.iterdir()} == {"out.dxf", "out.json", "out.csv", "strip.step"}

@@ -1,12 +1,12 @@
-"""The sheet-metal torture set: real STEP parts from public repositories (``../shared/sheetmetal_torture``).
+"""The sheet-metal torture set: real STEP parts from public repositories (``tests/data/torture``).
 
 Every part either unfolds or is refused with one ``patterns`` error naming the file and the cause, on
 one line.  The references are independent of the unfolder: the flat patterns Fusion 360 drew for the
 same parts (DXF files in the source repository, read back with ezdxf), the plate face's area and its
 holes for a flat plate (build123d), the solid's volume over the thickness (the blank's area at
 K = 0.5: the mid-surface), and the bend lines Fusion drew on its ``BEND`` layer.  Provenance and
-licence: docs/sheet-metal.md ("Torture set") and the folder's PROVENANCE.md; the folder is data kept beside
-the repository, never in it: without it these tests skip, saying so.
+licence: docs/sheet-metal.md ("Torture set") and the folder's PROVENANCE.md (both licences permit keeping the
+files here, with their texts); ``make_torture.py`` there rebuilds the folder from the two source repositories.
 """
 
 from __future__ import annotations
@@ -22,9 +22,7 @@ import patterns
 from patterns.cli import main
 from patterns.errors import InputError
 
-DATA = Path(__file__).resolve().parent.parent.parent / "shared" / "sheetmetal_torture"
-if not (DATA / "parts.csv").is_file():
-    pytest.skip(f"{DATA} is absent (the torture set's parts, kept beside the repository)", allow_module_level=True)
+DATA = Path(__file__).resolve().parent / "data" / "torture"
 with open(DATA / "parts.csv", newline="") as _f:
     ROWS = {row["part"]: row for row in csv.DictReader(_f)}
 K = 0.44

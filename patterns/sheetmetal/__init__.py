@@ -92,7 +92,7 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
     shape = prepared(shape, name)  # one solid; B-spline faces that are planes, cylinders or cones made so
     topology = read_topology(shape, name=name)
     faces = recognise(topology)
-    sheet = find_sheet(topology, faces, opts.fixed_face, name)
+    sheet = find_sheet(shape, topology, faces, opts.fixed_face, name)
     curvature = curvatures(faces, sheet, name)
     meshed = {i: meshed_face(faces[i], sheet.thickness, opts.k_factor if opts.material is None else  # K even with a
                            partial(opts.k_factor_at, sheet.thickness, what=f"{name}: face {i}"), name)  # bend table

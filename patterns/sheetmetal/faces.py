@@ -95,12 +95,16 @@ def recognise(topology: Topology) -> tuple:
 
 def normal(f: SheetFace, u: float, v: float) -> np.ndarray:
     """(3,) the face's outward unit normal at parameters ``(u, v)``."""
-    from OCP.BRepGProp import BRepGProp_Face
     from OCP.gp import gp_Pnt, gp_Vec
+    from OCP.TopAbs import TopAbs_REVERSED
 
-    p, n = gp_Pnt(), gp_Vec()
-    BRepGProp_Face(f.face).Normal(u, v, p, n)
-    n = np.array([n.X(), n.Y(), n.Z()])
+    # du x dv, turned over for a reversed face: what BRepGProp_Face.Normal gives, without building a new surface
+    # adaptor (and its parameter box, linear in the face's edges) per call: a plate with 5000 holes took 2 ms a call
+    p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+    f.adaptor.D1(u, v, p, du, dv)
+    n = np.cross([du.X(), du.Y(), du.Z()], [dv.X(), dv.Y(), dv.Z()])
+    if f.face.Orientation() == TopAbs_REVERSED:
+        n = -n
     return n / np.linalg.norm(n)
 
 

@@ -51,7 +51,7 @@ class SheetModel:
     neighbours: tuple
 
 
-def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: str) -> SheetModel:
+def find_sheet(shape, topology: Topology, faces: tuple, fixed_face: int | None, name: str) -> SheetModel:
     """The sheet: its fixed face, thickness and skin.
 
     The fixed face is ``fixed_face`` when given, else the largest planar face
@@ -83,7 +83,7 @@ def find_sheet(topology: Topology, faces: tuple, fixed_face: int | None, name: s
                 raise InputError(f"{name}: not a sheet: face {fixed} and the faces joined to it smoothly are "
                                  f"{share:.0%} of the part's surface, one side of a sheet nearly half (a block, a "
                                  f"thick plate, the end of a tube)")
-            return SheetModel(_thickness(faces, fixed, name), fixed, frozenset(skin), neighbours)
+            return SheetModel(_thickness(shape, faces, fixed, name), fixed, frozenset(skin), neighbours)
         except InputError as exc:
             first = first or exc
     if fixed_face is None and len(planes) > 1:
@@ -118,23 +118,65 @@ def _equal_sides_inside_first(planes: list, faces) -> list:
     return out
 
 
-def _thickness(faces, fixed, name) -> float:
-    """Distance from the fixed planar face to the nearest opposite parallel face behind it, mm."""
+def _thickness(shape, faces, fixed, name) -> float:
+    """Distance from the fixed planar face to the opposite parallel face behind it, mm.
+
+    The nearest such face, unless the part is not sheet there: a counterbore's floor on the far side is
+    an opposite face nearer than the far skin, so each depth, nearest first, is tried at points spread over the
+    fixed face; the thickness is the first depth just past which most of them leave the solid."""
     f = faces[fixed]
     u, v = uv_mid(f.face)
     n, p = normal(f, u, v), point(f, u, v)
-    best = None
+    depths = set()
     for g in faces:
         if g.kind != "plane" or g.index == fixed:
             continue
         gu, gv = uv_mid(g.face)
         m, q = normal(g, gu, gv), point(g, gu, gv)
-        depth = -(q - p) @ n
-        if m @ n < -1 + 1e-8 and depth > 1e-6 and (best is None or depth < best):
-            best = depth
-    if best is None:
+        depth = float(-(q - p) @ n)
+        if m @ n < -1 + 1e-8 and depth > 1e-6:
+            depths.add(round(depth, 9))
+    if not depths:
         raise InputError(f"{name}: not a sheet: face {fixed} has no parallel face behind it (no constant thickness)")
-    return float(best)
+    depths = sorted(depths)
+    if len(depths) == 1:
+        return depths[0]
+    samples = _points_on(f)
+    for depth in depths:
+        if _outside_share(shape, samples - (depth * (1 + 1e-6) + 1e-6) * n) > 0.5:
+            return depth
+    return depths[0]
+
+
+def _points_on(f, n: int = 9) -> np.ndarray:
+    """(k, 3) points of a planar face: a grid over its parameter box, those inside the face (holes out), mm."""
+    from OCP.BRepTools import BRepTools
+    from OCP.gp import gp_Pnt2d
+    from OCP.IntTools import IntTools_FClass2d
+    from OCP.TopAbs import TopAbs_IN
+
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(f.face)
+    inside = IntTools_FClass2d(f.face, 1e-7)
+    us, vs = u0 + (u1 - u0) * (np.arange(n) + 0.5) / n, v0 + (v1 - v0) * (np.arange(n) + 0.5) / n
+    out = [point(f, float(a), float(b)) for a in us for b in vs
+           if inside.Perform(gp_Pnt2d(float(a), float(b))) == TopAbs_IN]
+    return np.array(out).reshape(-1, 3)
+
+
+def _outside_share(shape, points: np.ndarray) -> float:
+    """The share of ``points`` ((k, 3) mm) outside the solid ``shape`` (1 when there are none)."""
+    from OCP.BRepClass3d import BRepClass3d_SolidClassifier
+    from OCP.gp import gp_Pnt
+    from OCP.TopAbs import TopAbs_OUT
+
+    if not len(points):
+        return 1.0
+    classifier = BRepClass3d_SolidClassifier(shape)
+    out = 0
+    for x, y, z in points:
+        classifier.Perform(gp_Pnt(float(x), float(y), float(z)), 1e-7)
+        out += classifier.State() == TopAbs_OUT
+    return out / len(points)
 
 
 def _tangent_edges(topology: Topology, faces) -> dict:

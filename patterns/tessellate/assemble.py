@@ -78,16 +78,16 @@ def _merged(occ_of_edge, panel_of_face, freeform, total: int):
 
 
 def _panel(name, label, members, meshes, offsets, root, coords, surfaces, *, closes: bool):
-    """``(Panel, local (total,) face-vertex -> panel vertex or -1, cuts made [(path, sides)])``."""
-    total = len(root)
+    """``(Panel, local, cuts made [(path, sides)])``: ``local`` is a :class:`_Local`, the panel's own face-vertices
+    and their panel vertices (the panel's, not the whole part's: an array of every face-vertex per panel was
+    quadratic in the faces, 22 GB for a plate with 5,000 holes)."""
     tri = np.concatenate([offsets[k] + meshes[k].triangles for k in members])
     fv = np.concatenate([np.arange(offsets[k], offsets[k + 1]) for k in members])
     roots, first = unique_ints(root[fv], return_index=True)
     order = np.argsort(first)
-    index = np.full(root.max() + 1, -1, dtype=np.int64)
-    index[roots[order]] = np.arange(len(roots))
-    local = np.full(total, -1, dtype=np.int64)
-    local[fv] = index[root[fv]]
+    rank = np.empty(len(roots), dtype=np.int64)
+    rank[order] = np.arange(len(roots))  # the panel vertex of each root (sorted), numbered by first appearance
+    local = _Local(fv, rank[np.searchsorted(roots, root[fv])])
     vertices, faces = coords[fv[first[order]]], local[tri]
     pname = f"{name}: panel {label}"
     made = []
@@ -101,6 +101,19 @@ def _panel(name, label, members, meshes, offsets, root, coords, surfaces, *, clo
         surface, param = surfaces[k], meshes[k].param[fv[first[order]] - offsets[k]]
     panel = panel_from_mesh(label, vertices, faces, name=pname, cad_faces=members, surface=surface, param=param)
     return panel, local, made
+
+
+class _Local:
+    """One panel's map from face-vertex ids (of the whole part) to its own vertex numbers."""
+
+    def __init__(self, face_vertices: np.ndarray, panel_vertices: np.ndarray):
+        order = np.argsort(face_vertices, kind="stable")
+        self.keys, self.values = face_vertices[order], panel_vertices[order]
+
+    def __getitem__(self, ids: np.ndarray) -> np.ndarray:
+        """The panel vertices of face-vertex ``ids`` (any shape, each one of the panel's)."""
+        ids = np.asarray(ids)
+        return self.values[np.searchsorted(self.keys, ids)]
 
 
 def _edge_seams(topology, division, occ_of_edge, panel_of_face, self_merged, local_of) -> list:
