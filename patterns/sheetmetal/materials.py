@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import InputError
 from ..files import check_input_file, csv_table
 
-__all__ = ["BUNDLED", "COLUMNS", "MaterialTable", "bundled_materials", "read_material_table"]
+__all__ = ["BUNDLED", "COLUMNS", "MaterialTable", "bundled_materials", "material_name", "read_material_table"]
 
 COLUMNS = ("material", "thickness_min", "thickness_max", "rt_min", "rt_max", "k_factor")
 """A material table's columns (mm, the ratio r/t, the K-factor)."""
@@ -87,7 +87,7 @@ class MaterialTable:
             An unknown material (the message lists the known ones), or no row covering the thickness and
             ``r/t`` (the message says what the rows cover); ``what`` names the bend.
         """
-        material = material.strip().lower()
+        material = material_name(material)
         if material not in self.names:
             raise InputError(f"unknown material {material!r}; {self.where} has {', '.join(self.names)}")
         mine = self.rows[[m == material for m in self.materials]]
@@ -128,6 +128,11 @@ def read_material_table(path) -> MaterialTable:
         raise InputError(f"{path}: not a text (CSV) file") from None
 
 
+def material_name(text: str) -> str:
+    """A material's name as the tables, the option and the lookup all spell it: stripped, lower case."""
+    return text.strip().lower()
+
+
 def _parse(fh, path: str | None) -> MaterialTable:
     where = path or "the bundled material table"
     reader = csv_table(fh, COLUMNS, where=where, what="a material table")
@@ -135,7 +140,7 @@ def _parse(fh, path: str | None) -> MaterialTable:
     try:
         for line, row in enumerate(reader, start=2):
             row = {k.strip().lower(): (v or "").strip() for k, v in row.items() if k is not None}
-            name = row["material"].lower()
+            name = material_name(row["material"])
             try:
                 values = [float(row[c]) for c in COLUMNS[1:]]
             except ValueError:

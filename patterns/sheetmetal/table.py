@@ -19,7 +19,7 @@ from ..errors import InputError
 from ..files import check_input_file, csv_table
 from ..options import Options, label, option
 from .corners import CORNER_RELIEFS
-from .materials import MaterialTable, _path_or_table, bundled_materials
+from .materials import MaterialTable, _path_or_table, bundled_materials, material_name
 
 __all__ = ["BendTable", "UnfoldOptions", "read_bend_table"]
 
@@ -133,7 +133,7 @@ def _check_row(path, line, thickness, radius, angle, deduction) -> None:
 def _material(value, option) -> str:
     if not isinstance(value, str) or not value.strip():
         raise InputError(f"{option} must be a material's name, got {value!r}")
-    return value.strip().lower()
+    return material_name(value)
 
 
 K_DEFAULT = 0.5
