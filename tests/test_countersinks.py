@@ -267,6 +267,7 @@ def test_compare_takes_a_flat_pattern_with_an_open_contour_when_asked(tmp_path):
 
 
 def test_compare_open_notes(tmp_path, capsys):
+    """What ``--compare-open leave-out`` and a bend sheet of no bends print: one note each, naming the file."""
     from patterns.cli import main
 
     bd.export_step(bd.Box(100, 60, 2), str(tmp_path / "plate.step"))

@@ -13,12 +13,16 @@ its skin (within 1 %) is refused too, by :func:`check_volume`.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import InputError
 from ..tessellate.topology import Topology
 from .faces import normal, point, uv_mid
+
+if TYPE_CHECKING:
+    from OCP.TopoDS import TopoDS_Shape
 
 __all__ = ["SheetModel", "check_volume", "find_sheet"]
 
@@ -51,7 +55,7 @@ class SheetModel:
     neighbours: tuple
 
 
-def find_sheet(shape, topology: Topology, faces: tuple, fixed_face: int | None, name: str) -> SheetModel:
+def find_sheet(shape: TopoDS_Shape, topology: Topology, faces: tuple, fixed_face: int | None, name: str) -> SheetModel:
     """The sheet: its fixed face, thickness and skin.
 
     The fixed face is ``fixed_face`` when given, else the largest planar face
@@ -118,7 +122,7 @@ def _equal_sides_inside_first(planes: list, faces) -> list:
     return out
 
 
-def _thickness(shape, faces, fixed, name) -> float:
+def _thickness(shape: TopoDS_Shape, faces: tuple, fixed: int, name: str) -> float:
     """Distance from the fixed planar face to the opposite parallel face behind it, mm.
 
     The nearest such face, unless the part is not sheet there: a counterbore's floor on the far side is
@@ -163,7 +167,7 @@ def _points_on(f, n: int = 9) -> np.ndarray:
     return np.array(out).reshape(-1, 3)
 
 
-def _outside_share(shape, points: np.ndarray) -> float:
+def _outside_share(shape: TopoDS_Shape, points: np.ndarray) -> float:
     """The share of ``points`` ((k, 3) mm) outside the solid ``shape`` (1 when there are none)."""
     from OCP.BRepClass3d import BRepClass3d_SolidClassifier
     from OCP.gp import gp_Pnt
