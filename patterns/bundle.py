@@ -29,7 +29,7 @@ from .errors import InputError
 from .export import WriteOptions
 from .flattening import FlattenOptions
 from .nesting import NestOptions
-from .options import Spec, cli_flags, flag_of, from_arguments, is_number, naming, parse_text, suggest
+from .options import Spec, cli_flags, flag_of, from_arguments, given_flags, is_number, naming, parse_text, suggest
 from .pieces import PieceOptions
 from .pieces.options import PATTERN_ONLY
 from .reading import LoadOptions
@@ -234,13 +234,14 @@ class Bundle:
         A flag the kind has not (``--seam-allowance`` to unfold) is refused when it is given.
         """
         made = {}
+        typed = given_flags(args)
         for slot in _kind_of(kind, name).slots:
             flags = cli_flags(slot.record)
             for skipped in slot.skip:
                 dest = flags[skipped].lstrip("-").replace("-", "_")
                 given = getattr(args, dest, None)
                 default = next(f.default for f in fields(slot.record) if f.name == skipped)
-                if given not in (None, default, False, []):
+                if (flags[skipped] in typed) if typed is not None else given not in (None, default, False, []):
                     raise InputError(f"{flags[skipped]} is a flattened pattern's option: a {kind} has none")
             made[slot.name] = from_arguments(slot.record, args, name=name,
                                              **{f: getattr(slot.record(), f) for f in slot.skip})

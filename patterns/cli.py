@@ -263,11 +263,12 @@ def command_index() -> dict:
 def _parse(argv) -> argparse.Namespace:
     """The parsed command line; an unknown option is named with the command's closest one ("did you mean
     --seam-allowance?") and the command's own --help, not the list of commands."""
-    from .options import suggest
+    from .options import given_flags, suggest
 
     parser = _parser()
     args, extras = parser.parse_known_args(argv)
-    args.given = {a.split("=", 1)[0] for a in argv if a.startswith("--")}  # the flags given (defaults aside)
+    args.given = given_flags(args) or set()  # the flags given (defaults aside), as the parser read them,
+    args.given |= {a.split("=", 1)[0] for a in argv if a.startswith("--")}  # and as typed
     if extras:
         command = parser.commands[args.command]
         known = [flag for action in command._actions for flag in action.option_strings]
@@ -291,6 +292,7 @@ def _bundle(args, name=None):
             print(f"note: --units is --input-units for {args.command} (0.2.0's name, kept until 0.3.0)",
                   file=sys.stderr)
             values["input_units"] = args.units
+            values["given"] = args.given | {"--input-units"}
         args = argparse.Namespace(**values)
     if args.command == "info":
         return Bundle.from_arguments("load", args, name=name)

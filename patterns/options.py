@@ -31,7 +31,7 @@ from .errors import InputError
 from .units import LARGEST_LENGTH
 
 __all__ = ["Options", "Spec", "add_arguments", "check_number", "check_ratio", "cli_flags", "from_arguments", "from_text",
-           "is_number", "label", "naming", "option", "parse_text", "suggest"]
+           "given_flags", "is_number", "label", "naming", "option", "parse_text", "suggest"]
 
 _LABELS: contextvars.ContextVar = contextvars.ContextVar("patterns_option_labels", default=None)
 """``{option name: what to call it}`` while a record is made from the command line's flags (the flags)."""
@@ -377,7 +377,7 @@ def add_arguments(parser, record: type, *, skip: tuple = ()) -> None:
                     raise TypeError(f"{record.__name__}.{f.name}: an option on by default needs off= (its --no- help)")
                 flag = spec.flag or "--no-" + f.name.replace("_", "-")
                 text = spec.off.replace("%", "%%")
-            parser.add_argument(flag, dest=_dest(flag), action="store_true", help=text)
+            parser.add_argument(flag, dest=_dest(flag), action=_actions()["flag"], help=text)
             continue
         kind = _typed(spec.parse) if spec.parse else (int if spec.integer else float if spec.choices is None and (
             spec.low is not None or spec.high is not None or is_number(f.default)) else str)
@@ -386,9 +386,57 @@ def add_arguments(parser, record: type, *, skip: tuple = ()) -> None:
         default = None if spec.repeat else f.default
         default = default.value if isinstance(default, Enum) else default
         parser.add_argument(flag, dest=_dest(flag), type=kind, default=default, choices=spec.choices,
-                            action="append" if spec.repeat else "store", metavar=spec.metavar,
+                            action=_actions()["append" if spec.repeat else "store"], metavar=spec.metavar,
                             help=text + ("" if default in (None, "") else f" (default {default})"))
     del argparse
+
+
+def given_flags(args) -> set | None:
+    """The flags the user typed on the command line that made ``args`` (each as :func:`add_arguments` declared
+    it, an abbreviation read as its whole flag), or None when ``args`` came from elsewhere (built by hand)."""
+    given = vars(args).get("given")
+    return None if given is None else set(given)
+
+
+_ACTIONS: dict = {}
+
+
+def _actions() -> dict:
+    """``{"store", "append", "flag"}`` -> argparse actions that do what argparse's own do and note the flag in
+    the namespace's ``given`` set: a value typed equal to the default is still the user's choice (``--material
+    X --k-factor 0.5`` is refused, not read as "no K-factor given")."""
+    if _ACTIONS:
+        return _ACTIONS
+    import argparse
+
+    def note(namespace, action):
+        given = vars(namespace).get("given")
+        if given is None:
+            given = set()
+            namespace.given = given
+        given.add(action.option_strings[0])
+
+    class Store(argparse.Action):
+        def __call__(self, parser, namespace, values, option_string=None):
+            setattr(namespace, self.dest, values)
+            note(namespace, self)
+
+    class Append(argparse.Action):
+        def __call__(self, parser, namespace, values, option_string=None):
+            setattr(namespace, self.dest, [*(getattr(namespace, self.dest, None) or ()), values])
+            note(namespace, self)
+
+    class Flag(argparse.Action):
+        def __init__(self, option_strings, dest, default=False, required=False, help=None):
+            super().__init__(option_strings, dest, nargs=0, const=True, default=default, required=required,
+                             help=help)
+
+        def __call__(self, parser, namespace, values, option_string=None):
+            setattr(namespace, self.dest, True)
+            note(namespace, self)
+
+    _ACTIONS.update(store=Store, append=Append, flag=Flag)
+    return _ACTIONS
 
 
 def _or_none(kind: Callable) -> Callable:
@@ -417,8 +465,13 @@ def _typed(parse: Callable) -> Callable:
 
 
 def from_arguments(record: type, args, *, name: str | None = None, **extra):
-    """The ``record`` (an :class:`Options` class) from parsed ``args`` (see :func:`add_arguments`), plus ``extra``."""
+    """The ``record`` (an :class:`Options` class) from parsed ``args`` (see :func:`add_arguments`), plus ``extra``.
+
+    When ``args`` notes the flags the user typed (:func:`given_flags`), only those are passed to the record,
+    the rest left at the record's defaults, so that the record sees what was given, as :meth:`Options.of`
+    sees the API's keywords."""
     values = {}
+    given = given_flags(args)
     for f in fields(record):
         spec = f.metadata.get("spec")
         if spec is None or f.name in extra:
@@ -427,6 +480,8 @@ def from_arguments(record: type, args, *, name: str | None = None, **extra):
         dest = _dest(spec.flag or "--no-" + f.name.replace("_", "-")) if negated else _dest(flag_of(f.name, spec))
         if dest not in vars(args):
             continue  # a field the parser has no flag for (skipped by add_arguments): its default
+        if given is not None and cli_flags(record)[f.name] not in given:
+            continue  # not typed: the record's default
         if negated:
             values[f.name] = not getattr(args, dest)
         else:

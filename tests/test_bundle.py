@@ -89,6 +89,8 @@ def test_messages_name_the_option_as_the_door_it_came_through_names_it():
         Bundle("unfold", pieces=patterns.PieceOptions(seam_allowance=3))
     with pytest.raises(InputError, match=r"^--seam-allowance is a flattened pattern's option"):
         _cli(["batch", "folder", "-o", "out", "--unfold", "--seam-allowance", "3"])
+    with pytest.raises(InputError, match=r"^--seam-allowance is a flattened pattern's option"):  # typed at 0
+        _cli(["batch", "folder", "-o", "out", "--unfold", "--seam-allowance", "0"])
 
 
 def test_batch_keeps_the_old_meaning_of_max_strain_and_gap_for_a_minor_version_with_a_warning():

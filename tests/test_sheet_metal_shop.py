@@ -216,6 +216,8 @@ def test_material_with_k_factor_or_bend_table_and_unknown_material_are_refused(t
         patterns.unfold(part, material="stainless", bend_table=bend_table)
     with pytest.raises(patterns.InputError, match=r"material gives every bend its K-factor, k_factor gives"):
         patterns.unfold(part, material="stainless", k_factor=0.4)
+    with pytest.raises(patterns.InputError, match=r"material gives every bend its K-factor, k_factor gives"):
+        patterns.unfold(part, material="stainless", k_factor=0.5)  # the default's value, given: still two answers
     with pytest.raises(patterns.InputError, match=r"unknown material 'steel'; the bundled material table has "
                                                   r"aluminium-5052, aluminium-6061, mild-steel, stainless"):
         patterns.unfold(part, material="steel")
@@ -227,6 +229,10 @@ def test_material_with_k_factor_or_bend_table_and_unknown_material_are_refused(t
     assert main(["unfold", str(step), "-o", str(tmp_path / "s.dxf"), "--material", "stainless",
                  "--bend-table", str(bend_table)]) == 2
     assert "--material gives every bend its K-factor, --bend-table gives them too" in capsys.readouterr().err
+    for flag in ("--k-factor", "--k-fac"):  # typed at the default's value, and abbreviated as argparse allows
+        assert main(["unfold", str(step), "-o", str(tmp_path / "s.dxf"), "--material", "stainless", flag,
+                     "0.5"]) == 2
+        assert "--material gives every bend its K-factor, --k-factor gives them too" in capsys.readouterr().err
     table = tmp_path / "shop.csv"  # an input: the bend sheet may not overwrite it
     table.write_text("material,thickness_min,thickness_max,rt_min,rt_max,k_factor\nbrass,1,3,0,3,0.4\n")
     assert main(["unfold", str(step), "-o", str(tmp_path / "s.dxf"), "--material", "brass", "--material-table",

@@ -161,6 +161,12 @@ def _table(value, option):
     raise InputError(f"{option} must be a CSV file's path or a BendTable, got {type(value).__name__}")
 
 
+def _both(other: str) -> InputError:
+    """The refusal of ``material`` with ``other`` (``k_factor`` or ``bend_table``), named as the caller typed them."""
+    return InputError(f"{label('material')} gives every bend its K-factor, {label(other)} gives them too: "
+                      f"give one of {label('material')}, {label('k_factor')} and {label('bend_table')}")
+
+
 @dataclass(frozen=True, repr=False)
 class UnfoldOptions(Options):
     """How a bent sheet-metal part is unfolded (:func:`unfold`, ``patterns unfold``)."""
@@ -198,15 +204,24 @@ class UnfoldOptions(Options):
                 raise InputError(f"{label('material_table')} gives K-factors by material: name the material "
                                  f"({label('material')} NAME)")
             return
-        given = [label(n) for n, on in (("bend_table", self.bend_table is not None),
-                                        ("k_factor", self.k_factor != K_DEFAULT)) if on]
+        given = [n for n, on in (("bend_table", self.bend_table is not None),
+                                 ("k_factor", self.k_factor != K_DEFAULT)) if on]
         if given:
-            raise InputError(f"{label('material')} gives every bend its K-factor, {given[0]} gives them too: "
-                             f"give one of {label('material')}, {label('k_factor')} and {label('bend_table')}")
+            raise _both(given[0])
         table = self.material_table or bundled_materials()
         if self.material not in table.names:
             raise InputError(f"unknown {label('material')} {self.material!r}; {table.where} has "
                              f"{', '.join(table.names)}")
+
+    @classmethod
+    def of(cls, options=None, keywords=None, *, name: str | None = None):
+        """As :meth:`Options.of`; ``k_factor`` given with ``material`` is refused even at its default value
+        (``--material X --k-factor 0.5``): the keywords say what was given, the record alone cannot."""
+        made = super().of(options, keywords, name=name)
+        if made.material is not None and "k_factor" in (keywords or {}):
+            exc = _both("k_factor")
+            raise InputError(f"{name}: {exc}" if name else str(exc))
+        return made
 
     def k_factor_at(self, thickness: float, inside_radius: float, *, what: str = "a bend") -> float:
         """A bend's K-factor: the material table's for its thickness and inside radius (mm) when ``material``
