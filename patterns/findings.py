@@ -75,6 +75,9 @@ class Code(str, Enum):
     press brake draws it out of shape (:mod:`patterns.sheetmetal.rules`)."""
     SHORT_FLANGE = "short-flange"
     """A flange of a blank too short to rest on the shoulder of a 6 t V-die through the bend."""
+    RELIEF_NOT_DRAWN = "relief-not-drawn"
+    """A corner where a relief of the size asked (``corner_relief_size``, ``corner_relief_ratio``) does not
+    reach a flange's edge: that corner is drawn closed."""
     MISSING_RELIEF = "missing-relief"
     """A bend that ends against unbent material of its blank with no relief cut there: the corner tears."""
     TINY_PART = "tiny-part"

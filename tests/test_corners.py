@@ -175,3 +175,65 @@ def test_of_two_equal_sides_the_one_the_walls_rise_from_is_fixed(tray):
     other = patterns.unfold(path, k_factor=K, fixed_face=outside)
     overlaps = [f for f in other.findings if f.code is patterns.Code.FLANGES_OVERLAP]
     assert not other.ok and len(overlaps) == 4  # each corner's two mitred outside skins
+
+
+def _crossings(blank) -> list:
+    """The points where two of the blank's bend lines cross (the tray's four corners)."""
+    lines, out = [b.line for b in blank.bends], []
+    for i in range(len(lines)):
+        for j in range(i + 1, len(lines)):
+            (p, q), (r, s) = lines[i], lines[j]
+            m = np.column_stack([q - p, r - s])
+            if abs(np.linalg.det(m)) > 1e-6:
+                a, _ = np.linalg.solve(m, r - p)
+                out.append(p + a * (q - p))
+    return out
+
+
+@pytest.mark.parametrize("size", [1.0, 10.0, 20.0])
+def test_a_sized_relief_is_the_square_or_circle_of_that_size_about_the_bend_lines_crossing(tray, size):
+    """SolidWorks' corner relief "centred on bend lines": the closed-corner blank less a square of side
+    ``size`` (a circle of diameter ``size``) about each crossing of two bend lines, built with shapely."""
+    square = _unfold(tray, "none")
+    centres = _crossings(square)
+    assert len(centres) == 4
+    path, inside = tray
+    rect = patterns.unfold(path, k_factor=K, fixed_face=inside, corner_relief="rectangular", corner_relief_size=size)
+    ref = square.outline.polygon.difference(shapely.union_all(
+        [shapely.box(*(c - size / 2), *(c + size / 2)) for c in centres]))
+    assert rect.area == pytest.approx(ref.area, abs=1e-6)
+    assert rect.outline.polygon.symmetric_difference(ref).area < 1e-6
+    by_ratio = patterns.unfold(path, k_factor=K, fixed_face=inside, corner_relief="rectangular",
+                               corner_relief_ratio=size / T)  # the same size, as a multiple of the thickness
+    assert by_ratio.area == pytest.approx(rect.area, abs=1e-9)
+    rnd = patterns.unfold(path, k_factor=K, fixed_face=inside, corner_relief="round", corner_relief_size=size)
+    ref = square.outline.polygon.difference(shapely.union_all(
+        [shapely.Point(c).buffer(size / 2, quad_segs=512) for c in centres]))
+    assert sum(isinstance(p, patterns.curves.Arc) for p in rnd.outline.pieces) == 4
+    assert rnd.area == pytest.approx(ref.area, rel=1e-7)  # the circle sampled finely
+    for blank in (rect, rnd):
+        assert blank.ok and not [f for f in blank.findings if f.code is patterns.Code.RELIEF_NOT_DRAWN]
+
+
+def test_a_relief_too_small_to_reach_the_flanges_is_drawn_closed_and_said(tray):
+    """0.2 mm about a crossing that lies 0.118 mm inside the closed corner's notch: no flange edge is reached."""
+    path, inside = tray
+    square = _unfold(tray, "none")
+    edge = min(square.outline.polygon.exterior.distance(shapely.Point(c)) for c in _crossings(square))
+    assert 0.1 < edge  # the square of 0.2 mm does not reach the outline
+    small = patterns.unfold(path, k_factor=K, fixed_face=inside, corner_relief="rectangular", corner_relief_size=0.2)
+    assert small.area == pytest.approx(square.area, abs=1e-9)
+    said = [f for f in small.findings if f.code is patterns.Code.RELIEF_NOT_DRAWN]
+    assert len(said) == 1 and len(said[0].points) == 4 and "4 corners drawn closed" in said[0].message
+
+
+def test_a_relief_size_is_refused_without_a_relief_that_has_one_or_given_twice(tray):
+    path, inside = tray
+    for relief in ("none", "tear", "as-modelled"):
+        with pytest.raises(patterns.InputError, match=rf"corner_relief_size sizes a rectangular or round corner "
+                                                      rf"relief; corner_relief is '{relief}', which has no size"):
+            patterns.unfold(path, corner_relief=relief, corner_relief_size=5)
+    with pytest.raises(patterns.InputError, match="corner_relief_size and corner_relief_ratio both size"):
+        patterns.unfold(path, corner_relief="round", corner_relief_size=5, corner_relief_ratio=2)
+    with pytest.raises(patterns.InputError, match="corner_relief_size must be"):
+        patterns.unfold(path, corner_relief="round", corner_relief_size=0)

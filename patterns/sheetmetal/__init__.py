@@ -27,6 +27,8 @@ from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
+import numpy as np
+
 from ..blank import Bend, Blank
 from ..errors import InputError
 from ..findings import Code, Finding, Severity
@@ -104,8 +106,10 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
     motions, gaps = place_faces(topology, maps, sheet, name)
     lines = [bend_line(maps, motions, b) for b in bends]
     zones = {i: (line, b.allowance / 2) for b, line in zip(bends, lines) for i in b.faces}
+    missed: list = []  # corners a relief of the size asked does not reach
     loops, open_ends = cut_loops(topology, maps, motions, sheet.skin, name, relief=opts.corner_relief,
-                                 thickness=sheet.thickness, bend_lines=zones)
+                                 thickness=sheet.thickness, bend_lines=zones,
+                                 relief_size=opts.relief_size(sheet.thickness), missed=missed)
     outline = max(loops, key=lambda lp: lp[0].area)[0]
     holes = tuple(lp for lp, _ in loops if lp is not outline)
     holes, rims = hole_rims(topology, faces, maps, motions, sheet, holes)  # countersinks: cut at the through hole
@@ -122,6 +126,13 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
     findings += [Finding(Code.BEND_WITHOUT_FLANGE, Severity.NOTE, (name,), bend.line.mean(axis=0)[None, :], (), None,
                          f"{name}: bend at faces {', '.join(map(str, bend.faces))} has no flat face on one side")
                  for bend, group in zip(drawn, bends) if not group.flanged]
+    if missed:
+        findings.append(Finding(
+            Code.RELIEF_NOT_DRAWN, Severity.NOTE, (name,), np.array(missed), (), None,
+            f"{name}: {counted(len(missed), 'corner')} drawn closed: a {opts.corner_relief} relief "
+            f"{opts.relief_size(sheet.thickness):g} mm across does not reach the flanges' edges there (they are "
+            f"further from the bend lines' crossing); give a larger size, or leave it out for the one that "
+            f"clears both bend zones"))
     for i, m in sorted(meshed.items()):
         d = m.flattening.distortion
         findings.append(Finding(

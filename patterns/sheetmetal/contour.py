@@ -76,9 +76,11 @@ def _piece(edge, face: int, maps: dict, motions: dict, flip: bool):
 
 
 def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, name: str, *, relief: str = "none",
-              thickness: float = 0.0, bend_lines: dict | None = None) -> tuple:
+              thickness: float = 0.0, bend_lines: dict | None = None, relief_size: float | None = None,
+              missed: list | None = None) -> tuple:
     """The cut contour: skin edges that meet a rim, chained into closed loops by their vertices, with the
-    corners where bends meet treated as ``relief`` says (:func:`~patterns.sheetmetal.corners.treat_corners`).
+    corners where bends meet treated as ``relief`` says, of ``relief_size`` mm when given (``missed`` gets
+    where that size does not reach a flange's edge: :func:`~patterns.sheetmetal.corners.treat_corners`).
 
     Returns
     -------
@@ -122,7 +124,8 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
             at = to
             if at == first:
                 break
-        treated = (treat_corners(pieces, relief=relief, thickness=thickness, bend_lines=bend_lines or {}) if closed
+        treated = (treat_corners(pieces, relief=relief, thickness=thickness, bend_lines=bend_lines or {},
+                                 size=relief_size, missed=missed) if closed
                    else [(p, f) for p, f, _ in pieces])  # an open loop is drawn as it is found
         loops.append((Loop(tuple(p for p, _ in treated)), tuple(f for _, f in treated)))
     return loops, gaps

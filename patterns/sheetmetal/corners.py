@@ -18,9 +18,17 @@ by the corner its option names:
     The rectangle where the two bend zones cross is cut out: the edges run
     to the zones' inside tangent lines and meet at the inside corner of the
     flat face between the bends (a square relief "tangent to the bends").
+    Given a size, a square of that side centred on the bend lines' crossing
+    (a parallelogram with sides along the bend lines where they are not
+    square), as SolidWorks' rectangular relief "centred on bend lines".
 ``"round"``
     A circle about the crossing of the two bend lines through that inside
-    corner (so it clears both bend zones), the edges cut back to it.
+    corner (so it clears both bend zones), the edges cut back to it; given a
+    size, a circle of that diameter about the crossing.
+
+A relief of a given size that does not reach a flange's edge (smaller than
+the flange's edge is far from the crossing) cannot be cut as asked: that
+corner is drawn closed and said (``relief-not-drawn``).
 ``"tear"``
     No material taken out: a straight rip from each flange's edge to the
     inside corner (a V-shaped slit).
@@ -39,10 +47,13 @@ import numpy as np
 
 from ..curves import Arc, Line, Polyline
 
-__all__ = ["CORNER_RELIEFS", "REACH", "treat_corners"]
+__all__ = ["CORNER_RELIEFS", "REACH", "SIZED_RELIEFS", "treat_corners"]
 
 CORNER_RELIEFS = ("none", "rectangular", "round", "tear", "as-modelled")
 """The corner treatments :func:`treat_corners` knows (``UnfoldOptions.corner_relief``)."""
+SIZED_RELIEFS = ("rectangular", "round")
+"""The corner reliefs that take a size (``UnfoldOptions.corner_relief_size`` or ``corner_relief_ratio``): the
+square's side or the circle's diameter, centred on the crossing of the two bend lines."""
 
 REACH = 3.0
 """Two edges meet "at" a corner when their crossing lies within this many thicknesses of the run they replace."""
@@ -94,7 +105,8 @@ def _runs(items: list, short: float) -> list:
     return runs
 
 
-def treat_corners(items: list, *, relief: str, thickness: float, bend_lines: dict) -> list:
+def treat_corners(items: list, *, relief: str, thickness: float, bend_lines: dict, size: float | None = None,
+                  missed: list | None = None) -> list:
     """One cut loop with the corners where bends meet treated as ``relief`` says.
 
     Parameters
@@ -109,6 +121,12 @@ def treat_corners(items: list, *, relief: str, thickness: float, bend_lines: dic
     bend_lines : dict
         ``{face: ((2, 2) float64, float)}``: the centre line of the bend each bend face belongs to and half
         its developed width, mm.
+    size : float, optional
+        A rectangular or round relief's size, mm (the square's side, the circle's diameter), centred on the
+        bend lines' crossing; default: just clear both bend zones.
+    missed : list, optional
+        Gets the ``(2,) float64`` crossing of the bend lines, mm, of each corner where a relief of ``size``
+        does not reach a flange's edge (that corner is drawn closed).
 
     Returns
     -------
@@ -146,7 +164,11 @@ def treat_corners(items: list, *, relief: str, thickness: float, bend_lines: dic
             j = change[0]
             inner = 0.5 * (_ends(items[ends[j - 1]][0])[1] + _ends(items[ends[j]][0])[0])
         lines = [bend_lines.get(faces[0]), bend_lines.get(faces[-1])]
-        new = _corner(relief, a, b, corner, inner, lines)
+        new = _corner(relief, a, b, corner, inner, lines, size)
+        if isinstance(new, np.ndarray):  # the relief asked for does not reach a flange's edge: closed, and said
+            if missed is not None:
+                missed.append(new)
+            new = None
         if new is None:
             new_a, middle, new_b = Line(a.start, corner), [], Line(corner, b.end)
         else:
@@ -184,8 +206,9 @@ def _inside_corner(near, lines):
     return best
 
 
-def _corner(relief, a: Line, b: Line, corner, inner, lines):
-    """``(a', [pieces between], b')`` for a relief, or None for the plain corner (``"none"``, or no inside corner)."""
+def _corner(relief, a: Line, b: Line, corner, inner, lines, size=None):
+    """``(a', [pieces between], b')`` for a relief, None for the plain corner (``"none"``, or no inside corner),
+    or the bend lines' crossing ((2,) float64) where a relief of ``size`` does not reach a flange's edge."""
     if relief == "none" or inner is None:
         return None
     inner = _inside_corner(inner, lines)  # exact, even where the model's mitre nicks the face between the bends
@@ -195,20 +218,24 @@ def _corner(relief, a: Line, b: Line, corner, inner, lines):
     da, db = da / np.linalg.norm(da), db / np.linalg.norm(db)
     if relief == "tear":
         return a, [Line(a.end, inner), Line(inner, b.start)], b
-    if relief == "rectangular":
-        q1 = inner + ((a.end - inner) @ da) * da  # a's end, dropped onto the line through the inside corner along a
-        q2 = inner + ((b.start - inner) @ db) * db
-        return a, [Line(a.end, q1), Line(q1, inner), Line(inner, q2), Line(q2, b.start)], b
-    # round: about the crossing of the two bend lines, through the inside corner
     (p, q), (r, w) = lines[0][0], lines[1][0]
     hit = _cross(p, q - p, r, w - r)
     if hit is None:
         return None
     centre = hit[0]
-    radius = float(np.linalg.norm(inner - centre))
+    if relief == "rectangular" and size is not None:
+        return _sized_square(a, b, da, db, inner, lines, size, centre)
+    if relief == "rectangular":
+        q1 = inner + ((a.end - inner) @ da) * da  # a's end, dropped onto the line through the inside corner along a
+        q2 = inner + ((b.start - inner) @ db) * db
+        return a, [Line(a.end, q1), Line(q1, inner), Line(inner, q2), Line(q2, b.start)], b
+    # round: about the crossing of the two bend lines, through the inside corner (or of the diameter asked)
+    radius = float(np.linalg.norm(inner - centre)) if size is None else size / 2
     ea, eb = _on_circle(a.start, da, centre, radius, first=True), _on_circle(b.start, db, centre, radius, first=False)
     if ea is None or eb is None:
-        return None
+        return None if size is None else centre
+    if size is not None and ((ea - a.start) @ da <= 0 or (b.end - eb) @ db <= 0):
+        return centre  # the circle takes a flange's whole edge
     start = float(np.arctan2(*(ea - centre)[::-1]))
     end = float(np.arctan2(*(eb - centre)[::-1]))
     via = float(np.arctan2(*(inner - centre)[::-1]))  # the arc goes round by the inside corner
@@ -216,6 +243,33 @@ def _corner(relief, a: Line, b: Line, corner, inner, lines):
     if (via - start) % (2 * np.pi) > sweep:
         sweep -= 2 * np.pi
     return Line(a.start, ea), [Arc(centre, radius, start, sweep)], Line(eb, b.end)
+
+
+def _sized_square(a: Line, b: Line, da, db, inner, lines, size: float, centre):
+    """The rectangular relief of side ``size`` centred on the bend lines' crossing ``centre``: ``(a', [pieces],
+    b')``, or ``centre`` when a flange's edge does not cross it.  ``a`` is the edge of the flange beyond the
+    first bend (``lines[0]``), ``b`` of the one beyond the second; ``inner`` the inside corner of the face
+    between the bends (it says on which side of each bend line that face lies)."""
+    (p, q), _ = lines[0]
+    (r, w), _ = lines[1]
+    u, v = (q - p) / np.linalg.norm(q - p), (w - r) / np.linalg.norm(w - r)
+    n1, n2 = np.array([-u[1], u[0]]), np.array([-v[1], v[0]])
+    s1, s2 = np.sign((inner - centre) @ n1), np.sign((inner - centre) @ n2)  # the flat face's side of each line
+    half = size / 2
+
+    def at(k1, k2):  # the relief's corner k1 half sizes off the first bend line, k2 off the second
+        return _cross(centre + k1 * half * n1, u, centre + k2 * half * n2, v)[0]
+
+    near, q1, q2 = at(s1, s2), at(-s1, s2), at(s1, -s2)
+    ea, eb = _cross(a.start, da, centre - s1 * half * n1, u), _cross(b.start, db, centre - s2 * half * n2, v)
+    if ea is None or eb is None:
+        return centre
+    ea, eb = ea[0], eb[0]
+    far_a, far_b = at(-s1, -s2), at(-s1, -s2)
+    on_side = all(np.dot(e - x, e - y) <= 1e-12 * size * size for e, x, y in ((ea, q1, far_a), (eb, q2, far_b)))
+    if not on_side or (ea - a.start) @ da <= 0 or (b.end - eb) @ db <= 0:
+        return centre  # a flange's edge passes by the relief, or the relief takes its whole edge
+    return Line(a.start, ea), [Line(ea, q1), Line(q1, near), Line(near, q2), Line(q2, eb)], Line(eb, b.end)
 
 
 def _on_circle(p, d, centre, radius, *, first: bool):

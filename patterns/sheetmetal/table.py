@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import InputError
 from ..files import check_input_file, csv_table
 from ..options import Options, label, option
-from .corners import CORNER_RELIEFS
+from .corners import CORNER_RELIEFS, SIZED_RELIEFS
 from .materials import MaterialTable, _path_or_table, bundled_materials, material_name
 
 __all__ = ["BendTable", "UnfoldOptions", "read_bend_table"]
@@ -187,6 +187,15 @@ class UnfoldOptions(Options):
                                         "crossing, clear of both zones), tear (a rip to the inside corner) or "
                                         "as-modelled (the model's corner faces developed as they are)",
                                 choices=CORNER_RELIEFS)
+    corner_relief_size: float | None = option(None, "the corner relief's size, mm: the square's side (rectangular) "
+                                                    "or the circle's diameter (round), centred on the bend lines' "
+                                                    "crossing, as SolidWorks' corner relief centred on bend lines "
+                                                    "(default: just clear both bend zones)",
+                                              optional=True, low=0, low_open=True, unit="mm")
+    corner_relief_ratio: float | None = option(None, "the corner relief's size as a multiple of the thickness "
+                                                     "(SolidWorks' ratio to thickness), instead of "
+                                                     "corner_relief_size", optional=True, low=0, low_open=True,
+                                               high=100, metavar="RATIO")
     material: str | None = option(None, "the sheet's material: each bend's K-factor from the material table, by "
                                         "the thickness and the bend's inside radius over it (r/t); the bundled table "
                                         "has " + ", ".join(bundled_materials().names) + " (see docs/sheet-metal.md)",
@@ -199,6 +208,13 @@ class UnfoldOptions(Options):
 
     def __post_init__(self):
         super().__post_init__()
+        sized = [n for n in ("corner_relief_size", "corner_relief_ratio") if getattr(self, n) is not None]
+        if len(sized) == 2:
+            raise InputError(f"{label('corner_relief_size')} and {label('corner_relief_ratio')} both size the corner "
+                             f"relief: give one")
+        if sized and self.corner_relief not in SIZED_RELIEFS:
+            raise InputError(f"{label(sized[0])} sizes a rectangular or round corner relief; "
+                             f"{label('corner_relief')} is {self.corner_relief!r}, which has no size")
         if self.material is None:
             if self.material_table is not None:
                 raise InputError(f"{label('material_table')} gives K-factors by material: name the material "
@@ -222,6 +238,13 @@ class UnfoldOptions(Options):
             exc = _both("k_factor")
             raise InputError(f"{name}: {exc}" if name else str(exc))
         return made
+
+    def relief_size(self, thickness: float) -> float | None:
+        """The corner relief's size, mm (``corner_relief_size``, or ``corner_relief_ratio`` times the
+        ``thickness``, mm), or None: just clear both bend zones."""
+        if self.corner_relief_ratio is not None:
+            return self.corner_relief_ratio * thickness
+        return self.corner_relief_size
 
     def k_factor_at(self, thickness: float, inside_radius: float, *, what: str = "a bend") -> float:
         """A bend's K-factor: the material table's for its thickness and inside radius (mm) when ``material``
