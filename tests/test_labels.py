@@ -135,8 +135,11 @@ def test_bend_labels_of_a_narrow_blank_lie_inside_it(tmp_path):
     patterns.write(blank, path)
     doc = ezdxf.readfile(path)
     (piece,) = _pieces(doc)
-    (bend,) = doc.modelspace().query("TEXT[layer=='BEND']")
+    bend, details = doc.modelspace().query("TEXT[layer=='BEND']")
     assert re.fullmatch(r"UP 90\.0 DEG R2", bend.dxf.text)
+    allowance = np.pi / 2 * (2.0 + 0.4 * 1.5)  # a quarter turn of the neutral layer, R2 + K t
+    assert details.dxf.text == f"BA {allowance:.2f} L 10.00 MM"  # the bend sheet's allowance and length
+    assert _glyphs(bend).distance(_glyphs(details)) > 0  # two lines, one beside the other
     (line,) = doc.modelspace().query("LINE[layer=='BEND']")
     x0, y0, x1, y1 = _glyphs(bend).bounds
     assert np.hypot(*(np.array(line.dxf.end) - np.array(line.dxf.start))[:2]) < max(x1 - x0, y1 - y0)

@@ -136,7 +136,9 @@ def test_patterns_and_blanks_share_one_convention(cup, bracket, tmp_path):
     assert b["CUT"][0] == 1 and b["LABEL"][0] == 7 and b["BEND"][0] == 2 and is_dashed(doc, b["BEND"][1])
     msp = doc.modelspace()
     assert {e.dxf.layer for e in msp.query("LWPOLYLINE CIRCLE")} == {"CUT"}
-    assert [t.dxf.text for t in msp.query("TEXT[layer=='BEND']")] == ["UP 90.0 DEG R3"]
+    allowance = np.pi / 2 * (3.0 + 0.44 * 2.0)  # R3 + K t, a quarter turn: the bend sheet's allowance
+    assert [t.dxf.text for t in msp.query("TEXT[layer=='BEND']")] == ["UP 90.0 DEG R3",
+                                                                      f"BA {allowance:.2f} L 40.00 MM"]
 
 
 @pytest.mark.parametrize("preset", sorted(PRESETS))

@@ -105,7 +105,9 @@ def test_bend_sheet_csv_and_dxf_text_agree_read_back(z_bracket, tmp_path, capsys
     texts = {t.dxf.text: shapely.MultiPoint([(v.x, v.y) for p in text2path.make_paths_from_entity(t)
                                              for v in p.flattening(0.01)]).convex_hull
              for t in msp.query("TEXT[layer=='BEND']")}
-    assert set(texts) == {"1 UP 90.0 DEG R3", "2 DOWN 90.0 DEG R3"}
+    details = f"BA {np.pi / 2 * (R + 0.3 * T):.2f} L {WIDTH:.2f} MM"  # the rows' allowance and bend length
+    assert set(texts) == {"1 UP 90.0 DEG R3", "2 DOWN 90.0 DEG R3", details}
+    assert [t.dxf.text for t in msp.query("TEXT[layer=='BEND']")].count(details) == 2  # one under each label
     for r in rows:
         mine = np.array([[float(r["x1_mm"]), float(r["y1_mm"])], [float(r["x2_mm"]), float(r["y2_mm"])]])
         assert min(min(np.abs(e - mine).max(), np.abs(e[::-1] - mine).max()) for e in lines) < 1e-4
@@ -349,7 +351,8 @@ def test_report_numbers_the_bends_as_the_dxf_does(z_bracket, tmp_path):
     assert sorted(b["sequence"] for b in piece["bends"]) == [1, 2]
     labels = sorted(lb["text"] for lb in piece["labels"] if lb["kind"] == "bend")
     # from the face the flanges rise from (of flange C's two equal sides): flange A's bend down, C's up
-    assert labels == ["1 DOWN 90.0 DEG R3", "2 UP 90.0 DEG R3"]
+    details = f"BA {np.pi / 2 * (R + 0.3 * T):.2f} L {WIDTH:.2f} MM"
+    assert labels == ["1 DOWN 90.0 DEG R3", "2 UP 90.0 DEG R3", details, details]
 
 
 @pytest.mark.slow

@@ -292,7 +292,7 @@ def test_dxf_holds_the_blank_and_its_bend_lines(strip_blank, tmp_path):
     linetype = doc.layers.get("BEND").dxf.linetype  # dashed: a pattern of dashes and gaps
     assert is_dashed(doc, linetype)
     texts = [t.dxf.text for t in msp.query("TEXT[layer=='BEND']")]
-    assert texts == ["UP 90.0 DEG R2"]
+    assert texts == ["UP 90.0 DEG R2", f"BA {np.pi / 2 * (2.0 + 0.4 * 1.5):.2f} L 30.00 MM"]  # R + K t; the width
     # on its line, from the bend's own line moved as the drawing moved the blank (5 mm from the axes)
     x0, y0 = strip_blank.polygon.bounds[:2]
     expected = strip_blank.bends[0].line + [5.0 - x0, 5.0 - y0]

@@ -32,7 +32,7 @@ import shapely
 
 from ..findings import Code, Finding, Severity
 from ..units import Unit
-from .piece import Label, Labels, Piece, SeamSide
+from .piece import BendLine, Label, Labels, Piece, SeamSide
 
 __all__ = ["LEAST_TEXT_HEIGHT", "Label", "LabelPlacer", "Labels", "label_findings", "labels_of", "least_height",
            "piece_labels", "place_labels", "readable_angle", "seam_text", "text_box", "with_labels"]
@@ -203,6 +203,19 @@ def seam_text(side: SeamSide, unit: Unit = Unit.MM) -> str:
             f"{unit.label}")
 
 
+def bend_details(bend: BendLine, unit: Unit = Unit.MM) -> str:
+    """The second line of a blank's bend label: its allowance (the developed width of its zone) and its
+    length, in the drawing's unit (``BA 4.20 L 30.00 MM``), as the bend sheet gives them; empty for a ruling.
+
+    Two decimals in mm, four in the larger units, as :func:`seam_text`.
+    """
+    if not bend.direction or bend.allowance is None:
+        return ""
+    digits = 2 if unit is Unit.MM else 4
+    length = float(np.linalg.norm(np.subtract(*bend.line)))
+    return f"BA {bend.allowance / unit.mm:.{digits}f} L {length / unit.mm:.{digits}f} {unit.label}"
+
+
 def _long_axis(polygon: shapely.Polygon) -> float:
     """The readable angle (degrees) of the longer side of the polygon's smallest turned rectangle."""
     ring = np.asarray(shapely.minimum_rotated_rectangle(polygon).exterior.coords)
@@ -256,15 +269,27 @@ def _place_all(piece: Piece, unit: Unit, block, *, title_first: bool) -> LabelPl
         direction = (b - a) / max(length, 1e-12)
         h = max(0.5 * th, placer.least)
         places = [b - direction * f * length for f in (0.1, 0.3, 0.5, 0.7, 0.9)]
+        details = bend_details(bend, unit)
+        # the label and its allowance and length, one line either side of the bend line; else the label alone
+        if details and placer.place_block([(bend.label, 0.7, 1.0), (details, -0.7, 1.0)], places, h,
+                                          readable_angle(direction), kind="bend", of=k, note=False):
+            continue
         if placer.place(bend.label, places, h, readable_angle(direction), kind="bend", of=k, note=False):
+            if details:
+                placer.left_out.append(Label(details, 0.5 * (a + b), h, readable_angle(direction), "bend", k))
             continue
         # too long for its line (a narrow blank): across it, beside its middle, on either side
         normal = np.array([-direction[1], direction[0]])
         for side in (normal, -normal):
             angle = readable_angle(side)
             shift = 1.0 if np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))]) @ side > 0 else -1.0
-            if placer.place(bend.label, [p + side * 0.5 * h for p in places[2:0:-1] + places[3:4]], h, angle, kind="bend", of=k,
-                            shift=shift, note=False):
+            beside = [p + side * 0.5 * h for p in places[2:0:-1] + places[3:4]]
+            if details and placer.place_block([(bend.label, 0.7, 1.0), (details, -0.7, 1.0)], beside, h, angle,
+                                              kind="bend", of=k, shift=shift, note=False):
+                break
+            if placer.place(bend.label, beside, h, angle, kind="bend", of=k, shift=shift, note=False):
+                if details:
+                    placer.left_out.append(Label(details, 0.5 * (a + b), h, readable_angle(direction), "bend", k))
                 break
         else:
             placer.left_out.append(Label(bend.label, 0.5 * (a + b), h, readable_angle(direction), "bend", k))

@@ -187,15 +187,6 @@ class UnfoldOptions(Options):
                                         "crossing, clear of both zones), tear (a rip to the inside corner) or "
                                         "as-modelled (the model's corner faces developed as they are)",
                                 choices=CORNER_RELIEFS)
-    corner_relief_size: float | None = option(None, "the corner relief's size, mm: the square's side (rectangular) "
-                                                    "or the circle's diameter (round), centred on the bend lines' "
-                                                    "crossing, as SolidWorks' corner relief centred on bend lines "
-                                                    "(default: just clear both bend zones)",
-                                              optional=True, low=0, low_open=True, unit="mm")
-    corner_relief_ratio: float | None = option(None, "the corner relief's size as a multiple of the thickness "
-                                                     "(SolidWorks' ratio to thickness), instead of "
-                                                     "corner_relief_size", optional=True, low=0, low_open=True,
-                                               high=100, metavar="RATIO")
     material: str | None = option(None, "the sheet's material: each bend's K-factor from the material table, by "
                                         "the thickness and the bend's inside radius over it (r/t); the bundled table "
                                         "has " + ", ".join(bundled_materials().names) + " (see docs/sheet-metal.md)",
@@ -205,6 +196,15 @@ class UnfoldOptions(Options):
                                                         "k_factor (default: the bundled table)",
                                                   optional=True, check=_path_or_table, metavar="CSV",
                                                   text=lambda table: table.path)
+    corner_relief_size: float | None = option(None, "the corner relief's size, mm: the square's side (rectangular) "
+                                                    "or the circle's diameter (round), centred on the bend lines' "
+                                                    "crossing, as SolidWorks' corner relief centred on bend lines "
+                                                    "(default: just clear both bend zones)",
+                                              optional=True, low=0, low_open=True, unit="mm")
+    corner_relief_ratio: float | None = option(None, "the corner relief's size as a multiple of the thickness "
+                                                     "(SolidWorks' ratio to thickness), instead of "
+                                                     "corner_relief_size", optional=True, low=0, low_open=True,
+                                               high=100, metavar="RATIO")
 
     def __post_init__(self):
         super().__post_init__()
