@@ -127,8 +127,22 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
         treated = (treat_corners(pieces, relief=relief, thickness=thickness, bend_lines=bend_lines or {},
                                  size=relief_size, missed=missed) if closed
                    else [(p, f) for p, f, _ in pieces])  # an open loop is drawn as it is found
+        treated = _joined(treated)
         loops.append((Loop(tuple(p for p, _ in treated)), tuple(f for _, f in treated)))
     return loops, gaps
+
+
+def _joined(pieces: list) -> list:
+    """A closed loop's ``(piece, face)`` list with a line across every place where a piece does not start
+    where the one before it ends (more than 10 nm: a meshed face's edge lands beside its neighbour's, as its
+    ``meshed-face`` note says), so that every piece is drawn whole, to its own end."""
+    out = []
+    for k, (piece, face) in enumerate(pieces):
+        out.append((piece, face))
+        end, start = piece.points()[-1], pieces[(k + 1) % len(pieces)][0].points()[0]
+        if np.linalg.norm(end - start) > 1e-5:
+            out.append((Line(end, start), face))
+    return out
 
 
 def bend_line(maps: dict, motions: dict, bend: BendGroup) -> np.ndarray:

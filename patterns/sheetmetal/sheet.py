@@ -80,7 +80,7 @@ def find_sheet(shape: TopoDS_Shape, topology: Topology, faces: tuple, fixed_face
     total = sum(f.area for f in faces)
     first = None
     for fixed in [fixed_face] if fixed_face is not None else [f.index for f in planes]:
-        skin = _skin(topology, tangent, neighbours, fixed, name)  # a sheet closed on itself: said at once
+        skin = _skin(topology, tangent, neighbours, fixed, name, faces)  # a sheet closed on itself: said at once
         try:
             share = sum(faces[i].area for i in skin) / total
             if share < SIDE:
@@ -220,8 +220,9 @@ def _neighbours(tangent: dict, n: int) -> tuple:
     return tuple(tuple(x) for x in neighbours)
 
 
-def _skin(topology: Topology, tangent: dict, neighbours: tuple, fixed: int, name: str) -> set:
-    """The faces reached from ``fixed`` across tangent edges."""
+def _skin(topology: Topology, tangent: dict, neighbours: tuple, fixed: int, name: str, faces=()) -> set:
+    """The faces reached from ``fixed`` across tangent edges; InputError where the skin closes on itself round
+    a face's own seam: a tube's, or a formed shell's when that face is doubly curved (a dimple's torus)."""
     skin, stack = {fixed}, [fixed]
     while stack:
         i = stack.pop()
@@ -231,6 +232,9 @@ def _skin(topology: Topology, tangent: dict, neighbours: tuple, fixed: int, name
                 stack.append(j)
     for e, pair in tangent.items():
         if pair is None and topology.edge_faces[e][0] in skin:
+            formed = [(i, k) for i, k in _doubly_curved(faces) if i in skin]
+            if topology.edge_faces[e][0] in {i for i, _ in formed}:
+                raise _formed(formed, name)
             raise InputError(f"{name}: the sheet closes on itself around face {topology.edge_faces[e][0]} "
                              f"(a tube with no seam): cut it along a line first")
     return skin
@@ -262,13 +266,17 @@ def check_volume(shape, sheet: SheetModel, faces, curvature: dict, meshed: dict,
     if abs(volume - expected) > 0.01 * volume:
         formed = _doubly_curved(faces)
         if formed:
-            raise InputError(f"{name}: faces {', '.join(str(i) for i, _ in formed[:6])}"
-                             f"{' ...' if len(formed) > 6 else ''} are doubly curved "
-                             f"({', '.join(sorted({k for _, k in formed}))}): a formed or drawn shell has no "
-                             f"flat blank to unfold (patterns flatten makes its pattern, with the strain)")
+            raise _formed(formed, name)
         raise InputError(f"{name}: not a sheet of constant thickness: the solid holds {volume:.0f} mm³, a "
                          f"{t:g} mm sheet over its skin {expected:.0f} mm³ (a machined block or a "
                          f"part of several thicknesses)")
+
+
+def _formed(formed: list, name: str) -> InputError:
+    """The refusal of a formed shell, naming its doubly curved faces (``formed``: :func:`_doubly_curved`'s)."""
+    return InputError(f"{name}: faces {', '.join(str(i) for i, _ in formed[:6])}{' ...' if len(formed) > 6 else ''} "
+                      f"are doubly curved ({', '.join(sorted({k for _, k in formed}))}): a formed or drawn shell "
+                      f"has no flat blank to unfold (patterns flatten makes its pattern, with the strain)")
 
 
 def _doubly_curved(faces) -> list:
