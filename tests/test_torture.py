@@ -12,10 +12,12 @@ files here, with their texts); ``make_torture.py`` there rebuilds the folder fro
 from __future__ import annotations
 
 import csv
+import json
 from pathlib import Path
 
 import build123d as bd
 import ezdxf
+import numpy as np
 import pytest
 
 import patterns
@@ -165,3 +167,43 @@ def test_cli_exit_code_message_and_output(part, tmp_path, capsys):
         assert code == 0 and err == ""
         assert patterns.read_flat_pattern(out).area == pytest.approx(patterns.read_flat_pattern(_fusion(part)).area,
                                                                      rel=1e-4)
+
+
+# --------------------------------------------------------------------------- #
+# Parts made in another CAD: FreeCAD's SheetMetal workbench (tests/data/torture/freecad)
+# --------------------------------------------------------------------------- #
+
+FREECAD_DATA = DATA / "freecad"
+with open(FREECAD_DATA / "parts.json") as _f:
+    FREECAD_PARTS = json.load(_f)
+
+
+@pytest.mark.parametrize("part", sorted(FREECAD_PARTS["parts"]))
+def test_a_part_made_in_freecad_sheetmetal_matches_its_own_unfold(part):
+    """Parts a FreeCAD user makes with the SheetMetal workbench's own features (base wall, walls, corner relief),
+    written by FreeCAD's STEP writer: our blank at the workbench's K-factor (0.4, ANSI) against the workbench's
+    own flat pattern, its DXF read back (coordinates to 6 significant digits: 3e-6 of the area) and the area of
+    its unfolded solid as FreeCAD measured it (``parts.json``); the holes and bend lines it drew."""
+    spec = FREECAD_PARTS["parts"][part]
+    assert FREECAD_PARTS["k_factor_standard"] == "ansi"
+    blank = patterns.unfold(FREECAD_DATA / f"{part}.step", k_factor=FREECAD_PARTS["k_factor"])
+    theirs = patterns.read_flat_pattern(FREECAD_DATA / f"{part}.dxf")
+    assert blank.area == pytest.approx(spec["flat_area"], rel=2e-6)  # FreeCAD's unfolded solid (its tray's arcs)
+    assert blank.area == pytest.approx(theirs.area, rel=1e-5)  # FreeCAD's DXF, 6 digits
+    k, t = FREECAD_PARTS["k_factor"], spec["t"]
+    holes = sum(np.pi * r * r for _, _, r in spec["holes"])
+    (x, y), (wall,) = spec["base"], spec["walls"]
+    allowance = np.pi / 2 * (wall["r"] + k * t)  # a quarter turn of the neutral layer; a wall's leg starts past it
+    by_hand = {  # the base, the bends and the legs ("Material Outside": the base keeps its size), less the cuts
+        "fc_l_bracket": (x + allowance + wall["leg"]) * y - holes,
+        "fc_u_channel": (y + 2 * (allowance + wall["leg"])) * x - holes,
+        "fc_relief_flange": x * y + (allowance + wall["leg"]) * (y - wall.get("gap1", 0) - wall.get("gap2", 0))
+        - holes - 2 * np.prod(wall.get("relief", [0, 0, 0])[1:]),  # two rectangular bend reliefs, 2 x 4
+    }
+    if part in by_hand:
+        assert blank.area == pytest.approx(by_hand[part], rel=1e-9)
+    assert len(blank.bends) == len(theirs.bend_lines) == spec["sketch_edges"]["Unfold_Sketch_Bends"]
+    assert len(blank.holes) == len(spec["holes"])
+    assert blank.ok
+    provenance = (FREECAD_DATA / "PROVENANCE.md").read_text()
+    assert f"`{part}" in provenance and "cbef3f2" in provenance

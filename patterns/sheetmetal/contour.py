@@ -132,16 +132,42 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
     return loops, gaps
 
 
+def _moved(piece, *, start=None, end=None):
+    """A line or polyline with its first or last point moved; None for an arc (kept whole)."""
+    if isinstance(piece, Line):
+        return Line(piece.start if start is None else start, piece.end if end is None else end)
+    if isinstance(piece, Polyline):
+        pts = piece.points().copy()
+        if start is not None:
+            pts[0] = start
+        if end is not None:
+            pts[-1] = end
+        return Polyline(pts)
+    return None
+
+
 def _joined(pieces: list) -> list:
-    """A closed loop's ``(piece, face)`` list with a line across every place where a piece does not start
-    where the one before it ends (more than 10 nm: a meshed face's edge lands beside its neighbour's, as its
-    ``meshed-face`` note says), so that every piece is drawn whole, to its own end."""
-    out = []
-    for k, (piece, face) in enumerate(pieces):
-        out.append((piece, face))
-        end, start = piece.points()[-1], pieces[(k + 1) % len(pieces)][0].points()[0]
+    """A closed loop's ``(piece, face)`` list in which every piece starts where the one before it ends.
+
+    Where they do not (more than 10 nm apart: a meshed face's edge lands beside its neighbour's, as its
+    ``meshed-face`` note says), the next piece's start is moved to the end of the one before (or that one's
+    end to the next's start, when the next is an arc; a line joins two arcs), so that every arc is drawn
+    whole, to its own ends, and no piece runs back over another.
+    """
+    out, k = list(pieces), 0
+    while k < len(out):
+        (piece, face), (after, face_after) = out[k], out[(k + 1) % len(out)]
+        end, start = piece.points()[-1], after.points()[0]
         if np.linalg.norm(end - start) > 1e-5:
-            out.append((Line(end, start), face))
+            last = k + 1 == len(out)  # the first piece keeps its start: the loop begins there
+            moved = None if last else _moved(after, start=end)
+            if moved is not None:
+                out[k + 1] = (moved, face_after)
+            elif (moved := _moved(piece, end=start)) is not None:
+                out[k] = (moved, face)
+            else:
+                out.insert(k + 1, (Line(end, start), face))  # two arcs: a line between them
+        k += 1
     return out
 
 

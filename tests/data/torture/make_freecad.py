@@ -29,7 +29,7 @@ what the workbench's own "export unfold sketch" calls): the outline sketch ``Unf
 
 FreeCAD 0.20 shims (the same as ``benchmarks/freecad_sheetmetal.py``): ``FreeCAD.Base.Precision`` (absent before
 1.0) is given OpenCascade's own values, ``Console.PrintUser*`` (absent before 0.21) go to ``PrintError``,
-``Part.sortEdges`` is called without the tolerance 0.20 does not take.  One more for running without the GUI:
+``Part.sortEdges`` is called without the tolerance 0.20 does not take.  Two more for running without the GUI:
 ``SheetMetalTools.taskRestoreDefaults`` (which restores the user's last-used values from the preferences and is
 defined only when the GUI is up) is a no-op, so every feature starts from its class defaults and the values set here;
 and the sketches the unfold makes get a stand-in ``ViewObject`` (``getUnfoldSketches`` sets the bend-line sketch's
@@ -50,28 +50,28 @@ K = 0.4
 
 PARTS = {
     # L bracket: 60 x 40 x 2 plate with a 8 mm hole, one 90 degree wall on a 40 mm edge, R 2, leg 30.
-    "fc_l_bracket": dict(t=2.0, base=(60.0, 40.0), holes=[(30.0, 20.0, 4.0)],
-                         walls=[dict(edge="x+", r=2.0, leg=30.0)]),
+    "fc_l_bracket": {"t": 2.0, "base": (60.0, 40.0), "holes": [(30.0, 20.0, 4.0)],
+                     "walls": [{"edge": "x+", "r": 2.0, "leg": 30.0}]},
     # U channel: 80 x 40 x 3 web with two 6 mm holes, walls on both 80 mm edges (one feature), R 3, legs 25.
-    "fc_u_channel": dict(t=3.0, base=(80.0, 40.0), holes=[(20.0, 20.0, 3.0), (60.0, 20.0, 3.0)],
-                         walls=[dict(edge=("y-", "y+"), r=3.0, leg=25.0)]),
+    "fc_u_channel": {"t": 3.0, "base": (80.0, 40.0), "holes": [(20.0, 20.0, 3.0), (60.0, 20.0, 3.0)],
+                     "walls": [{"edge": ("y-", "y+"), "r": 3.0, "leg": 25.0}]},
     # Tray: 100 x 70 x 1.5 base, four walls (one feature, auto-miter), R 1, legs 20; the workbench's circular
     # corner relief (size 3: radius 3 mm, centred where the two bends' flat zones meet) at the corner (0, 0) only.
     # Each corner relief adds some 120 KB of STEP (the workbench wraps every edge of the relief cut around the bend
     # as a B-spline through 50 points, SheetMetalBendSolid.wrap_face), so four of them would make a 556 KB file.
-    "fc_tray": dict(t=1.5, base=(100.0, 70.0), holes=[],
-                    walls=[dict(edge=("x-", "x+", "y-", "y+"), r=1.0, leg=20.0)],
-                    corner_relief=dict(type="Circle", size=3.0, corners=[(0.0, 0.0)])),
-    # Flange with bend relief: 80 x 50 x 2 plate, a 30 mm wide wall on the 50 mm edge (gaps 10 and 10 from its
-    # ends), R 2, leg 25, rectangular bend reliefs 2 wide and 4 deep.
-    "fc_relief_flange": dict(t=2.0, base=(80.0, 50.0), holes=[(40.0, 25.0, 5.0)],
-                             walls=[dict(edge="x+", r=2.0, leg=25.0, gap1=10.0, gap2=10.0,
-                                         relief=("Rectangle", 2.0, 4.0))]),
+    "fc_tray": {"t": 1.5, "base": (100.0, 70.0), "holes": [],
+                "walls": [{"edge": ("x-", "x+", "y-", "y+"), "r": 1.0, "leg": 20.0}],
+                "corner_relief": {"type": "Circle", "size": 3.0, "corners": [(0.0, 0.0)]}},
+    # Flange with bend relief: 80 x 50 x 2 plate with a 10 mm hole, a 30 mm wide wall on the 50 mm edge (gaps 10
+    # and 10 from its ends), R 2, leg 25, rectangular bend reliefs 2 wide and 4 deep.
+    "fc_relief_flange": {"t": 2.0, "base": (80.0, 50.0), "holes": [(40.0, 25.0, 5.0)],
+                         "walls": [{"edge": "x+", "r": 2.0, "leg": 25.0, "gap1": 10.0, "gap2": 10.0,
+                                    "relief": ("Rectangle", 2.0, 4.0)}]},
 }
 
 sys.path.insert(0, WORKBENCH)
-import FreeCAD  # noqa: E402
-import Part  # noqa: E402
+import FreeCAD
+import Part
 
 if not hasattr(FreeCAD.Base, "Precision"):  # FreeCAD < 1.0: OpenCascade's own tolerances
     class Precision:
@@ -88,22 +88,22 @@ _sort_edges = Part.sortEdges
 def _sort_edges_any(edges, *tolerance):  # FreeCAD < 1.0 takes no tolerance
     try:
         return _sort_edges(edges, *tolerance)
-    except Exception:
+    except Exception:  # noqa: BLE001 - whatever 0.20 raises for the extra argument
         return _sort_edges(edges)
 
 
 Part.sortEdges = _sort_edges_any
-import SheetMetalTools  # noqa: E402
+import SheetMetalTools
 
 if not hasattr(SheetMetalTools, "taskRestoreDefaults"):  # defined only with the GUI up
     SheetMetalTools.taskRestoreDefaults = lambda obj, names: None
-import importDXF  # noqa: E402
-import Import  # noqa: E402
-import SheetMetalBaseCmd  # noqa: E402
-import SheetMetalCmd  # noqa: E402
-import SheetMetalCornerReliefCmd  # noqa: E402
-import SheetMetalNewUnfolder  # noqa: E402
-import SheetMetalUnfoldCmd  # noqa: E402
+import Import
+import importDXF
+import SheetMetalBaseCmd
+import SheetMetalCmd
+import SheetMetalCornerReliefCmd
+import SheetMetalNewUnfolder
+import SheetMetalUnfoldCmd
 
 
 class _NoView:
@@ -257,7 +257,7 @@ def main():
                                          sketches=[s.Label for s in sketches],
                                          sketch_edges={s.Label: len(s.Shape.Edges) for s in sketches})
             print(f"MADE {name}: {len(shape.Faces)} faces, sketches {[s.Label for s in sketches]}", flush=True)
-        except Exception as exc:
+        except Exception as exc:  # noqa: BLE001 - recorded, and the next part is made
             record["parts"][name] = dict(spec, ok=False, error=" ".join(f"{type(exc).__name__}: {exc}".split()))
             print(f"FAILED {name}: {exc}", flush=True)
         FreeCAD.closeDocument(doc.Name)
