@@ -17,7 +17,6 @@ from __future__ import annotations
 import numpy as np
 import qdldl
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..measure import local_coordinates
 from ..mesh import Connectivity
@@ -27,13 +26,14 @@ __all__ = ["LDL", "Factor", "LDLFactor", "factorize", "lscm", "tutte_embedding"]
 
 
 class Factor:
-    """A sparse LU factorisation of a symmetric (or Hermitian) positive definite ``(n, n)`` matrix."""
+    """A sparse ``L D L^T`` factorisation of a symmetric (or Hermitian) positive definite ``(n, n)`` matrix."""
 
-    def __init__(self, lu, scale: float = 0.0, order: np.ndarray | None = None):
-        self._lu, self._scale, self._order = lu, scale, order
+    def __init__(self, solver, n: int, complex_: bool, order: np.ndarray | None = None):
+        self._solver, self._n, self._complex, self._order = solver, n, complex_, order
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """``A^-1 b`` for ``b`` of shape ``(n,)`` or ``(n, k)``, in the matrix's dtype (float64 if single)."""
+        """``A^-1 b`` for ``b`` of shape ``(n,)`` or ``(n, k)``: float64 (complex128 for a Hermitian matrix)."""
+        b = np.asarray(b)
         if self._order is not None:
             x = np.empty_like(b, dtype=np.result_type(b, np.float64))
             x[self._order] = self._solve(b[self._order])
@@ -41,30 +41,33 @@ class Factor:
         return self._solve(b)
 
     def _solve(self, b):
-        if not self._scale:
-            return self._lu.solve(b)
-        # Single precision: the right-hand side goes in at unit size, so that
-        # the rounding -- and the result -- does not depend on the unit.
-        size = float(np.abs(b).max()) or 1.0
-        x = self._lu.solve((b / size).astype(np.float32))
-        return x.astype(np.float64) * (size / self._scale)
+        if b.ndim == 2:
+            return np.column_stack([self._solve(b[:, k]) for k in range(b.shape[1])])
+        if self._complex:  # [[Re, -Im], [Im, Re]] [x; y] = [Re b; Im b]
+            x = self._solver.solve(np.ascontiguousarray(np.r_[b.real, b.imag], dtype=np.float64))
+            return x[:self._n] + 1j * x[self._n:]
+        return self._solver.solve(np.ascontiguousarray(b, dtype=np.float64))
 
 
-def factorize(matrix: sp.spmatrix, *, single: bool = False, order: np.ndarray | None = None) -> Factor:
-    """Sparse LU of a symmetric or Hermitian positive definite matrix, in a fill-reducing order.
+def factorize(matrix: sp.spmatrix, *, order: np.ndarray | None = None) -> Factor:
+    """Sparse ``L D L^T`` of a symmetric or Hermitian positive definite matrix (qdldl, AMD ordering).
+
+    qdldl is plain C with no BLAS beneath it, so a solve gives the same bits
+    on every CPU: SuperLU, used here before, calls the BLAS in its supernodes,
+    and OpenBLAS picks its kernels by CPU (with fused multiply-adds on one, not
+    on another), so the same cup flattened to different bits under
+    ``OPENBLAS_CORETYPE=Haswell`` and ``Sandybridge``, and the darts a search
+    cut followed those bits (issue 51).
 
     Parameters
     ----------
     matrix : (n, n) sparse, float64 or complex128
-    single : bool
-        Factorise in single precision (float32; real matrices only): about a
-        third faster to factorise and to solve with, for a preconditioner that
-        need not be exact.  :meth:`Factor.solve` still takes and returns float64.
+        A complex Hermitian matrix is factorised as the real symmetric
+        ``[[Re, -Im], [Im, Re]]`` of twice its size.
     order : (n,) int64, optional
-        The elimination order (:func:`patterns.flattening.numbering.dissection_order`),
-        or None for ``arange(n)``: the matrix is already in a good order.
-        SuperLU's own minimum-degree orderings depend on how the input was
-        numbered (a factor of 2-10 in time), so the engine never uses them.
+        A numbering to put the matrix in first
+        (:func:`patterns.flattening.numbering.dissection_order`); qdldl's
+        AMD orders it from there.
 
     Returns
     -------
@@ -77,17 +80,14 @@ def factorize(matrix: sp.spmatrix, *, single: bool = False, order: np.ndarray | 
     matrix = sp.csc_matrix(matrix)
     if order is not None:
         matrix = sp.csc_matrix(matrix[order][:, order])
-    scale = 0.0
-    if single:
-        # Divided by its mean diagonal first: float32 rounding is then the same
-        # in any unit (a mesh in inches factorises like the same mesh in mm).
-        scale = float(np.abs(matrix.diagonal()).mean())
-        matrix = sp.csc_matrix(matrix / scale, dtype=np.float32)
-    # Panels of 4 columns (SuperLU's default is 10) factorise these mesh
-    # Laplacians about a fifth faster; the factor itself is the same.
-    lu = spla.splu(matrix, permc_spec="NATURAL", panel_size=4, options={"SymmetricMode": True},
-                   diag_pivot_thresh=0.0)
-    return Factor(lu, scale, order)
+    n = matrix.shape[0]
+    complex_ = np.iscomplexobj(matrix.data)
+    if complex_:
+        re, im = sp.csc_matrix(matrix.real), sp.csc_matrix(matrix.imag)
+        matrix = sp.bmat([[re, -im], [im, re]], format="csc")
+    upper = sp.triu(matrix, format="csc")
+    upper.sort_indices()
+    return Factor(qdldl.Solver(upper, upper=True), n, complex_, order)
 
 
 class LDL:

@@ -316,9 +316,9 @@ class _System:
     with each triangle scaled by ``s_t`` (1 for ARAP at an isometry;
     ``1 + 3 / sigma_min**4`` for the symmetric Dirichlet energy, 4 at an
     isometry) and ``S`` the seam term's stiffness along the held edges.  The
-    mesh comes in nested-dissection order, so the plain matrix (``s = 1``) is
-    factorised as it is, once, in single precision by SuperLU (it only shapes
-    the steps); stiffened ones are refactorised numerically only by qdldl.
+    mesh comes in nested-dissection order; the plain matrix (``s = 1``) is
+    factorised once, stiffened ones refactorised numerically only, all by
+    qdldl (no BLAS beneath: the same bits on every CPU).
     """
 
     def __init__(self, conn, fr, free, seam, seam_index, *, pair: PairSystem | None = None):
@@ -329,7 +329,7 @@ class _System:
         weight = self.weights(None)
         self.anchor = float(np.abs(weight).mean()) if free.all() else 0.0
         matrix = _laplacian(len(free), conn.edges, weight, anchor=self.anchor)
-        self.plain = factorize(matrix if free.all() else matrix[free][:, free], single=True)
+        self.plain = factorize(matrix if free.all() else matrix[free][:, free])
         self._stiff = None
 
     def weights(self, scale) -> np.ndarray:
