@@ -296,9 +296,13 @@ def test_lscm_solves_the_real_least_squares_problem():
     assert np.abs(x.reshape(n, 2) - uv).max() < 1e-9 * np.ptp(uv, axis=0).max()
 
 
-def test_single_precision_factor_is_a_close_unit_free_preconditioner():
-    """The relaxation's preconditioner is factorised in float32; its solves must
-    stay close to the float64 ones and must not depend on the unit."""
+def test_the_factorisations_solve_real_and_hermitian_systems_in_any_unit():
+    """Every factorisation of the engine is qdldl's ``L D L^T`` (no BLAS beneath: the same bits on every CPU,
+    tests/test_determinism.py): its solves leave a residual at round-off, for the relaxation's Laplacian in
+    nested-dissection order and for LSCM's complex Hermitian matrix, and scale with the unit as ``L``
+    does (``unit**2``)."""
+    import scipy.sparse as sp
+
     from patterns.flattening.embed import factorize
     from patterns.flattening.numbering import dissection_order
     from patterns.flattening.relax import _laplacian
@@ -313,12 +317,18 @@ def test_single_precision_factor_is_a_close_unit_free_preconditioner():
     for unit in (1.0, 25.4):  # mm, then the same part in inches
         w = 1.0 / np.linalg.norm((v[e[:, 1]] - v[e[:, 0]]) / unit, axis=1) ** 2
         matrix = _laplacian(len(v), e, w, anchor=float(w.mean()))
-        exact = factorize(matrix, order=order).solve(b)
-        single = factorize(matrix, single=True, order=order).solve(b)
-        assert single.dtype == np.float64
-        assert np.linalg.norm(single - exact) < 1e-3 * np.linalg.norm(exact)
-        solutions.append(single * unit**2)  # L scales as unit**2, so L^-1 b as unit**-2
-    assert np.allclose(solutions[0], solutions[1], rtol=0, atol=1e-6 * np.abs(solutions[0]).max())
+        for ordered in (order, None):
+            x = factorize(matrix, order=ordered).solve(b)
+            assert x.dtype == np.float64 and x.shape == b.shape
+            assert np.linalg.norm(matrix @ x - b) < 1e-10 * np.linalg.norm(b)
+        solutions.append(x * unit**2)  # L scales as unit**2, so L^-1 b as unit**-2
+    assert np.allclose(solutions[0], solutions[1], rtol=0, atol=1e-9 * np.abs(solutions[0]).max())
+    twist = sp.random(len(v), len(v), density=3 / len(v), random_state=3) * 1e-3
+    hermitian = sp.csc_matrix(matrix + 1j * (twist - twist.T))  # Hermitian, positive definite
+    z = rng.normal(size=len(v)) + 1j * rng.normal(size=len(v))
+    x = factorize(hermitian).solve(z)
+    assert x.dtype == np.complex128
+    assert np.linalg.norm(hermitian @ x - z) < 1e-10 * np.linalg.norm(z)
 
 
 def test_min_stretch_guard_stops_crushed_triangles_and_changes_nothing_else():
