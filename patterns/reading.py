@@ -242,8 +242,9 @@ def read_mesh(path, *, weld_vertices: bool | None = None) -> MeshFile:
 _SKIPPED_REPAIRS = ("FixShape.FixSelfIntersectionMode", "FixShape.FixIntersectingWiresMode")
 """OpenCascade's shape-healing steps the readers skip: both test every pair of edges or wires of a face against
 each other, over the whole face each time, so a plate with 5,000 holes took 20 minutes to read.  Crossing wires
-come only from a broken export; unfolded, the crossing contours they make are refused by the blank's own contour
-check."""
+come only from a broken export: the meshing refuses a face whose boundary crosses itself
+(``tessellate.topology._check_wire``, each wire on its own), and unfolded, crossing contours are refused by the
+blank's own contour check."""
 
 
 def _lighter_repairs(reader) -> None:

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import CadError
 from .sizes import Sizes
 from .topology import Topology
 
@@ -40,6 +41,10 @@ class EdgeDivision:
         return len(self.gids[e]) - 1
 
 
+MOST_SEGMENTS = 1_000_000
+"""The most pieces one edge is cut into; more means a face of no area (its target edge length is ~0)."""
+
+
 def divide_edges(topology: Topology, sizes: Sizes, *, chord_tolerance: float, angular_tolerance: float
                  ) -> EdgeDivision:
     """Divide every edge at the finest edge length of its faces (shorter where it curves)."""
@@ -54,6 +59,10 @@ def divide_edges(topology: Topology, sizes: Sizes, *, chord_tolerance: float, an
             lengths.append(0.0)
             continue
         count = _count(curve, min(hs), chord_tolerance, angular_tolerance)
+        if count > MOST_SEGMENTS:  # a face of no area asks for edges of no length: never a real part
+            faces = ", ".join(str(k) for k in topology.edge_faces[e])
+            raise CadError(f"{topology.name}: edge {e} (of face {faces}) would be cut into {count:.3g} pieces: the "
+                           f"face has almost no area for its size (an invalid face); repair it in the CAD program")
         if first == last:
             count = max(count, 3)  # a closed edge: at least a triangle
         t, g, length = _divided(curve, count, first, last, points)

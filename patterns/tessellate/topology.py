@@ -100,11 +100,12 @@ def read_topology(shape, *, name: str) -> Topology:
             edges.index(edge)
         ex.Next()
     wires = []
-    for face in faces:
+    for k, face in enumerate(faces):
         walks = []
         wx = TopExp_Explorer(face, TopAbs_WIRE)
         while wx.More():
             walk = []
+            _check_wire(TopoDS.Wire(wx.Current()), face, k, name)
             we = BRepTools_WireExplorer(TopoDS.Wire(wx.Current()), face)
             while we.More():
                 edge = we.Current()
@@ -125,6 +126,24 @@ def read_topology(shape, *, name: str) -> Topology:
     return Topology(name=name, faces=tuple(faces), edges=tuple(edges.items),
                     degenerate=tuple(bool(BRep_Tool.Degenerated_s(e)) for e in edges.items),
                     wires=tuple(wires), edge_faces=tuple(tuple(f) for f in edge_faces), edge_vertices=ends)
+
+
+CHECKED_WIRE_EDGES = 500
+"""A face boundary (wire) of at most this many edges is checked for crossing itself; the check is
+pairwise in its edges (a plate's thousands of holes are thousands of wires of one edge each)."""
+
+
+def _check_wire(wire, face, index: int, name: str) -> None:
+    """CadError if a face's boundary crosses itself (a bow-tie outline): the STEP and IGES readers no longer
+    repair that (``reading._SKIPPED_REPAIRS``: the repair is pairwise over a face's wires), and such a face
+    has no inside to mesh (its signed area cancels out)."""
+    from OCP.BRep import BRep_Tool
+    from OCP.ShapeAnalysis import ShapeAnalysis_Wire
+
+    check = ShapeAnalysis_Wire(wire, face, BRep_Tool.Tolerance_s(face))
+    if check.NbEdges() <= CHECKED_WIRE_EDGES and check.CheckSelfIntersection():
+        raise CadError(f"{name}: face {index}'s boundary crosses itself (a bow-tie or a loop through itself): the "
+                       f"face is invalid; repair it in the CAD program and export it again")
 
 
 def _check_extent(shape, name: str) -> None:
