@@ -331,6 +331,33 @@ def test_the_factorisations_solve_real_and_hermitian_systems_in_any_unit():
     assert np.linalg.norm(hermitian @ x - z) < 1e-10 * np.linalg.norm(z)
 
 
+def test_past_the_exact_size_superlu_solves_and_its_float32_preconditioner_is_unit_free(monkeypatch):
+    """A matrix past ``EXACT_SIZE`` (a scan of a million faces) goes to SuperLU for its speed: in double
+    precision its solve leaves a residual at round-off; in single (the relaxation's plain ``K``) it stays
+    within 1e-3 of the double one and does not depend on the unit."""
+    from patterns.flattening import embed
+    from patterns.flattening.numbering import dissection_order
+    from patterns.flattening.relax import _laplacian
+
+    monkeypatch.setattr(embed, "EXACT_SIZE", 100)  # this 5,000-vertex cup counts as large
+    v, f = surfaces.ellipsoid_cup(n_faces=10_000)
+    v, f, conn = validate_mesh(v, f)
+    e = conn.edges
+    order = dissection_order(v, e)
+    b = np.random.default_rng(11).normal(size=(len(v), 2))
+    solutions = []
+    for unit in (1.0, 25.4):
+        w = 1.0 / np.linalg.norm((v[e[:, 1]] - v[e[:, 0]]) / unit, axis=1) ** 2
+        matrix = _laplacian(len(v), e, w, anchor=float(w.mean()))
+        exact = embed.factorize(matrix, order=order).solve(b)
+        assert np.linalg.norm(matrix @ exact - b) < 1e-10 * np.linalg.norm(b)
+        single = embed.factorize(matrix, single=True, order=order).solve(b)
+        assert single.dtype == np.float64
+        assert np.linalg.norm(single - exact) < 1e-3 * np.linalg.norm(exact)
+        solutions.append(single * unit**2)
+    assert np.allclose(solutions[0], solutions[1], rtol=0, atol=1e-6 * np.abs(solutions[0]).max())
+
+
 def test_min_stretch_guard_stops_crushed_triangles_and_changes_nothing_else():
     """ARAP alone presses part of a head flat (its fold-free minimum wants to fold there);
     the guard keeps every triangle open, and is zero where nothing is squeezed."""

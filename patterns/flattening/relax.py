@@ -317,8 +317,10 @@ class _System:
     ``1 + 3 / sigma_min**4`` for the symmetric Dirichlet energy, 4 at an
     isometry) and ``S`` the seam term's stiffness along the held edges.  The
     mesh comes in nested-dissection order; the plain matrix (``s = 1``) is
-    factorised once, stiffened ones refactorised numerically only, all by
-    qdldl (no BLAS beneath: the same bits on every CPU).
+    factorised once (:func:`~patterns.flattening.embed.factorize`: qdldl, no
+    BLAS beneath, the same bits on every CPU, up to ``EXACT_SIZE`` unknowns;
+    SuperLU in float32 past it), stiffened ones refactorised numerically only
+    by qdldl.
     """
 
     def __init__(self, conn, fr, free, seam, seam_index, *, pair: PairSystem | None = None):
@@ -329,7 +331,7 @@ class _System:
         weight = self.weights(None)
         self.anchor = float(np.abs(weight).mean()) if free.all() else 0.0
         matrix = _laplacian(len(free), conn.edges, weight, anchor=self.anchor)
-        self.plain = factorize(matrix if free.all() else matrix[free][:, free])
+        self.plain = factorize(matrix if free.all() else matrix[free][:, free], single=True)
         self._stiff = None
 
     def weights(self, scale) -> np.ndarray:
