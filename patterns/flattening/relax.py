@@ -76,6 +76,7 @@ _IMMATERIAL = 1e-14  # the relaxation stops at an energy of this per triangle: R
 # development never gets here: it is caught before any step, at RMS strain 1e-10)
 _PROXIMAL = 1e-6  # the projected Hessian's diagonal is raised by this fraction of its mean (a rigid turn is free)
 _MEMORY = 8  # L-BFGS pairs kept
+_JUMP = 0.1  # a step that cuts the energy below this fraction refactorises the stiffened matrix at once
 _DROP = 0.1  # the barrier weight is multiplied by this at each new stage
 _WEAKEST = 1e-5  # the last barrier stage before the energy alone
 _SEAM_RHO = 300.0  # seam penalty weight, relative to the held edge's triangle (30: slow rounds; 1000: stiffer steps)
@@ -469,6 +470,8 @@ class _Minimiser:
                 cand, new_value, new_grad, new_parts = step
                 new_hgrad = lu.solve(new_grad)
                 memory.add(self.restrict(cand - uv), new_grad - grad, new_hgrad - hgrad)
+                if stiff and new_value < _JUMP * value:
+                    since_refresh = self.refresh  # a crushed triangle opened: matrix and pairs made far from here
                 uv, value, grad, hgrad, parts = cand, new_value, new_grad, new_hgrad, new_parts
             if self.progress is not None:
                 self.progress(self.offset + iterations, self.total)
