@@ -71,18 +71,7 @@ def test_as_modelled_keeps_the_tongues_and_every_relief_is_cut_where_the_bends_c
     modelled = _unfold(tray, "as-modelled")
     assert modelled.perimeter > square.perimeter + 4 * 5.0  # a tongue of several mm at each corner
     blank = square.outline.polygon
-    lines = [b.line for b in square.bends]
-
-    def crossings():
-        for i in range(len(lines)):
-            for j in range(i + 1, len(lines)):
-                (p, q), (r, s) = lines[i], lines[j]
-                m = np.column_stack([q - p, r - s])
-                if abs(np.linalg.det(m)) > 1e-6:
-                    a, _ = np.linalg.solve(m, r - p)
-                    yield p + a * (q - p)
-
-    centres = list(crossings())
+    centres = _crossings(square)
     assert len(centres) == 4
     half = ALLOWANCE / 2
     squares = shapely.union_all([shapely.box(*(c - half), *(c + half)) for c in centres])

@@ -107,9 +107,10 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
     lines = [bend_line(maps, motions, b) for b in bends]
     zones = {i: (line, b.allowance / 2) for b, line in zip(bends, lines) for i in b.faces}
     missed: list = []  # corners a relief of the size asked does not reach
+    relief_size = opts.relief_size(sheet.thickness)
     loops, open_ends = cut_loops(topology, maps, motions, sheet.skin, name, relief=opts.corner_relief,
-                                 thickness=sheet.thickness, bend_lines=zones,
-                                 relief_size=opts.relief_size(sheet.thickness), missed=missed)
+                                 thickness=sheet.thickness, bend_lines=zones, relief_size=relief_size,
+                                 missed=missed)
     outline = max(loops, key=lambda lp: lp[0].area)[0]
     holes = tuple(lp for lp, _ in loops if lp is not outline)
     holes, rims = hole_rims(topology, faces, maps, motions, sheet, holes)  # countersinks: cut at the through hole
@@ -130,7 +131,7 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
         findings.append(Finding(
             Code.RELIEF_NOT_DRAWN, Severity.NOTE, (name,), np.array(missed), (), None,
             f"{name}: {counted(len(missed), 'corner')} drawn closed: a {opts.corner_relief} relief "
-            f"{opts.relief_size(sheet.thickness):g} mm across does not reach the flanges' edges there (they are "
+            f"{relief_size:g} mm across does not reach the flanges' edges there (they are "
             f"further from the bend lines' crossing); give a larger size, or leave it out for the one that "
             f"clears both bend zones"))
     for i, m in sorted(meshed.items()):

@@ -265,8 +265,8 @@ def _sized_square(a: Line, b: Line, da, db, inner, lines, size: float, centre):
     if ea is None or eb is None:
         return centre
     ea, eb = ea[0], eb[0]
-    far_a, far_b = at(-s1, -s2), at(-s1, -s2)
-    on_side = all(np.dot(e - x, e - y) <= 1e-12 * size * size for e, x, y in ((ea, q1, far_a), (eb, q2, far_b)))
+    far = at(-s1, -s2)  # the corner across from the flat face: each flange's edge crosses a side that ends there
+    on_side = all(np.dot(e - x, e - far) <= 1e-12 * size * size for e, x in ((ea, q1), (eb, q2)))
     if not on_side or (ea - a.start) @ da <= 0 or (b.end - eb) @ db <= 0:
         return centre  # a flange's edge passes by the relief, or the relief takes its whole edge
     return Line(a.start, ea), [Line(ea, q1), Line(q1, near), Line(near, q2), Line(q2, eb)], Line(eb, b.end)
