@@ -78,6 +78,9 @@ class Code(str, Enum):
     RELIEF_NOT_DRAWN = "relief-not-drawn"
     """A corner where a relief of the size asked (``corner_relief_size``, ``corner_relief_ratio``) does not
     reach a flange's edge: that corner is drawn closed."""
+    OBLIQUE_CUT = "oblique-cut"
+    """A cut across a bend whose wall is not square to the sheet (a hole drilled after bending): drawn as the
+    wall's trace on the neutral layer, which the two faces' traces are not."""
     MISSING_RELIEF = "missing-relief"
     """A bend that ends against unbent material of its blank with no relief cut there: the corner tears."""
     TINY_PART = "tiny-part"

@@ -14,12 +14,13 @@ chosen, never from the unfolder:
 * a dimple and a louver (spheres and tori: formed, doubly curved) have no developed length at all: the unfold
   must refuse them or name their formed faces, never flatten them silently.
 
-Tests that assert the correct behaviour where ``patterns`` is wrong today are ``xfail(strict=True)`` with the
-measured value in their reason.
+A drilled hole's wall is not square to the sheet: the unfold draws its trace on the neutral layer and says so
+(an ``oblique-cut`` note with both areas).
 """
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import build123d as bd
@@ -300,23 +301,37 @@ def test_drilled_trace_reference_is_ordered_and_converged():
     assert neutral == pytest.approx(_drilled_trace(0.75, k=0.5, n=80000), rel=1e-7)  # converged
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the hole is developed from the fixed face's skin only (patterns/sheetmetal/contour.py:96-104, cut_loops "
-    "walks the skin's edges): at K 0.5 its area is 85.224 mm2, the outside skin's trace (85.239), not the "
-    "neutral layer's 99.472 (-14.3 %; K 0.4: 82.978 against 100.084, -17.1 %); with fixed_face=0 (the "
-    "inside skin) it is 114.166; nothing says the "
-    "hole's wall is not square to the sheet"))
 @pytest.mark.parametrize("k", [0.5, 0.4])
 def test_hole_drilled_across_a_bend_develops_on_its_neutral_layer(k):
     """A 10 mm hole drilled along the bend's outside bisector: its blank hole is the drill's trace on the
-    neutral layer, developed (:func:`_drilled_trace`, 99.472 mm2 at K 0.5, 100.084 at K 0.4; within 1e-3: the
-    blank samples the hole as polylines), and the blank does not depend on which flat face is fixed."""
+    neutral layer, developed (:func:`_drilled_trace`, 99.472 mm2 at K 0.5, 100.084 at K 0.4; within 1e-4: the
+    blank samples the trace as polylines of 0.1 um chord error), the same which flat face is fixed (the inside
+    skin's trace is 114.166 mm2, the outside skin's 85.224), and an ``oblique-cut`` note gives both areas."""
     part = hole_across_bend()
     blank = patterns.unfold(part, k_factor=k, name="hole")
     (hole,) = blank.holes
-    assert hole.area == pytest.approx(_drilled_trace(k * T_L, k=k), rel=1e-3)
+    neutral = _drilled_trace(k * T_L, k=k)
+    assert hole.area == pytest.approx(neutral, rel=1e-4)
     other = patterns.unfold(part, k_factor=k, name="hole", fixed_face=0)  # the inside skin of flange A
+    assert other.holes[0].area == pytest.approx(neutral, rel=1e-4)
     assert other.area == pytest.approx(blank.area, rel=1e-6)
+    strip = (LA + LB + np.pi / 2 * (R_L + k * T_L)) * W_L
+    assert blank.area == pytest.approx(strip - neutral, rel=1e-6)
+    for b, skin in ((blank, _drilled_trace(T_L, k=k)), (other, _drilled_trace(0.0, k=k))):
+        (note,) = [f for f in b.findings if f.code is patterns.Code.OBLIQUE_CUT]
+        assert note.severity is patterns.Severity.NOTE and b.ok
+        assert f"neutral layer, {neutral:.2f} mm²" in note.message
+        drawn = float(re.search(r"the fixed face's trace ([0-9.]+) mm²", note.message).group(1))
+        assert drawn == pytest.approx(skin, rel=1e-3)  # that trace sampled at 1 um chord error
+        assert shapely.Point(note.points[0]).within(b.holes[0].polygon)
+
+
+def test_square_cuts_across_a_bend_are_not_redrawn():
+    """The slot's walls are square to the sheet (its sides square to the bend axis, its ends drilled square to
+    their flanges): drawn from the fixed face as before, arcs as arcs, and no ``oblique-cut`` note."""
+    blank = patterns.unfold(slot_across_bend(), k_factor=0.5, name="slot")
+    assert not [f for f in blank.findings if f.code is patterns.Code.OBLIQUE_CUT]
+    assert sum(type(p).__name__ == "Arc" for p in blank.holes[0].pieces) == 2
 
 
 # --------------------------------------------------------------------------- #
@@ -417,7 +432,7 @@ def test_louver_cut_contour_is_closed_and_written_as_drawn(tmp_path, capsys):
 # --------------------------------------------------------------------------- #
 
 CLI_CASES = {**{name: (lambda name=name: profile_part(name)) for name in PROFILES},
-             "slot": slot_across_bend, "corner": near_corner}
+             "slot": slot_across_bend, "corner": near_corner, "hole": hole_across_bend}
 
 
 def _reference_area(name: str) -> float:
@@ -427,6 +442,8 @@ def _reference_area(name: str) -> float:
     allowance = np.pi / 2 * (R_L + 0.5 * T_L)
     if name == "slot":
         return (LA + LB + allowance) * W_L - (6.0 * (10.0 + allowance + 13.0) + 9.0 * np.pi)
+    if name == "hole":
+        return (LA + LB + allowance) * W_L - _drilled_trace(0.5 * T_L, k=0.5)
     allowance = np.pi / 2 * 1.5  # the corner: r 1, t 1
     return 40.0**2 + 2 * allowance * 40.0 + 14.0 * 42.0 + 14.0 * 40.7
 

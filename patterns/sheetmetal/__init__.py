@@ -37,6 +37,7 @@ from ..tessellate.topology import read_topology
 from ..text import counted
 from .bends import curvatures, face_maps, group_bends
 from .contour import bend_line, clip_to, contour_faults, cut_loops, overlaps
+from .oblique import neutral_trace
 from .faces import recognise, uv_mid
 from .holes import hole_rims
 from .imported import prepared
@@ -108,10 +109,18 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
     zones = {i: (line, b.allowance / 2) for b, line in zip(bends, lines) for i in b.faces}
     missed: list = []  # corners a relief of the size asked does not reach
     relief_size = opts.relief_size(sheet.thickness)
+    chains: list = []  # each loop's skin edges
     loops, open_ends = cut_loops(topology, maps, motions, sheet.skin, name, relief=opts.corner_relief,
                                  thickness=sheet.thickness, bend_lines=zones, relief_size=relief_size,
-                                 missed=missed)
+                                 missed=missed, chains=chains)
     outline = max(loops, key=lambda lp: lp[0].area)[0]
+    oblique = []  # holes across a bend with a wall not square to the sheet: drawn on the neutral layer
+    for k, ((loop, on), chain) in enumerate(zip(loops, chains)):
+        retraced = None if loop is outline or chain is None else neutral_trace(
+            chain, topology=topology, faces=faces, sheet=sheet, bends=bends, maps=maps, motions=motions)
+        if retraced is not None:
+            oblique.append((loop, retraced, sorted({e for e, _, _ in chain})))
+            loops[k] = (retraced, on)
     holes = tuple(lp for lp, _ in loops if lp is not outline)
     holes, rims = hole_rims(topology, faces, maps, motions, sheet, holes)  # countersinks: cut at the through hole
     lines = [clip_to(line, outline) for line in lines]  # a bend line ends where a corner relief cuts its zone
@@ -127,6 +136,11 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
     findings += [Finding(Code.BEND_WITHOUT_FLANGE, Severity.NOTE, (name,), bend.line.mean(axis=0)[None, :], (), None,
                          f"{name}: bend at faces {', '.join(map(str, bend.faces))} has no flat face on one side")
                  for bend, group in zip(drawn, bends) if not group.flanged]
+    findings += [Finding(
+        Code.OBLIQUE_CUT, Severity.NOTE, (name,), retraced.vertices()[:, :2].mean(axis=0)[None, :], (), None,
+        f"{name}: the cut at edges {', '.join(map(str, edges))} crosses a bend with its wall not square to the "
+        f"sheet (drilled after bending): drawn as the wall's trace on the neutral layer, {retraced.area:.2f} mm² "
+        f"(the fixed face's trace {skin.area:.2f} mm²)") for skin, retraced, edges in oblique]
     if missed:
         findings.append(Finding(
             Code.RELIEF_NOT_DRAWN, Severity.NOTE, (name,), np.array(missed), (), None,

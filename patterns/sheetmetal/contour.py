@@ -77,10 +77,12 @@ def _piece(edge, face: int, maps: dict, motions: dict, flip: bool):
 
 def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, name: str, *, relief: str = "none",
               thickness: float = 0.0, bend_lines: dict | None = None, relief_size: float | None = None,
-              missed: list | None = None) -> tuple:
+              missed: list | None = None, chains: list | None = None) -> tuple:
     """The cut contour: skin edges that meet a rim, chained into closed loops by their vertices, with the
     corners where bends meet treated as ``relief`` says, of ``relief_size`` mm when given (``missed`` gets
     where that size does not reach a flange's edge: :func:`~patterns.sheetmetal.corners.treat_corners`).
+    ``chains``, when given, gets each loop's skin edges in the loop's order, ``((edge, face, reversed), ...)``
+    (None for a loop that does not close), for :func:`~patterns.sheetmetal.oblique.neutral_trace`.
 
     Returns
     -------
@@ -102,12 +104,12 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
                 flip = edge.Orientation() == TopAbs_REVERSED
                 a, b = topology.edge_vertices[e][::-1] if flip else topology.edge_vertices[e]
                 piece = _piece(edge, i, maps, motions, flip)
-                by_start.setdefault(a, []).append((b, (piece, i, is_bend_end(piece, maps[i].kind))))
+                by_start.setdefault(a, []).append((b, (piece, i, is_bend_end(piece, maps[i].kind)), (e, i, flip)))
     loops, gaps = [], []
-    ends = {b for chain in by_start.values() for b, _ in chain}
+    ends = {b for chain in by_start.values() for b, _, _ in chain}
     while by_start:
         first = next((v for v in by_start if v not in ends), next(iter(by_start)))  # an open chain from its start
-        pieces, at, closed = [], first, True
+        pieces, links, at, closed = [], [], first, True
         while True:
             nxt = by_start.get(at)
             if not nxt:  # open: closed by a line across the gap for the drawing, and said (an open-contour error)
@@ -117,10 +119,11 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
                     gaps.append(np.array([stop, start]))
                     pieces.append((Line(stop, start), pieces[-1][1], False))
                 break
-            to, piece = nxt.pop()
+            to, piece, link = nxt.pop()
             if not nxt:
                 del by_start[at]
             pieces.append(piece)
+            links.append(link)
             at = to
             if at == first:
                 break
@@ -129,6 +132,8 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
                    else [(p, f) for p, f, _ in pieces])  # an open loop is drawn as it is found
         treated = _joined(treated)
         loops.append((Loop(tuple(p for p, _ in treated)), tuple(f for _, f in treated)))
+        if chains is not None:
+            chains.append(tuple(links) if closed else None)
     return loops, gaps
 
 
