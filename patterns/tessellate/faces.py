@@ -130,21 +130,26 @@ def _slots(loops, occurrences, dev, h: float, where: str) -> _Boundary:
     slot_gid, slot_uv = [], []
     occ_slots = [np.full(count, -1, dtype=np.int64) for _, count in occurrences]
     rings = []
+    near = 0.01 * h
+
+    def same(a, b) -> bool:  # np.allclose(a, b, atol=near), without its cost per point
+        return abs(a[0] - b[0]) <= near + 1e-5 * abs(b[0]) and abs(a[1] - b[1]) <= near + 1e-5 * abs(b[1])
+
     for raw in loops:
         ring = []
         for gids, uv, occ, pos in raw:
             for g, p, q in zip(gids, dev.forward(uv), pos):
-                if ring and slot_gid[ring[-1]] == g and np.allclose(slot_uv[ring[-1]], p, atol=0.01 * h):
+                if ring and slot_gid[ring[-1]] == g and same(slot_uv[ring[-1]], p):
                     occ_slots[occ][q] = ring[-1]
                     continue
                 slot_gid.append(int(g))
                 slot_uv.append(p)
                 ring.append(len(slot_gid) - 1)
                 occ_slots[occ][q] = ring[-1]
-        if len(ring) > 1 and slot_gid[ring[0]] == slot_gid[ring[-1]] and \
-                np.allclose(slot_uv[ring[0]], slot_uv[ring[-1]], atol=0.01 * h):
+        if len(ring) > 1 and slot_gid[ring[0]] == slot_gid[ring[-1]] and same(slot_uv[ring[0]], slot_uv[ring[-1]]):
             last = ring.pop()
-            for o in occ_slots:
+            for occ in {occ for _, _, occ, _ in raw}:  # the slot is this wire's own: only its edges hold it
+                o = occ_slots[occ]
                 o[o == last] = ring[0]
             slot_gid.pop()
             slot_uv.pop()
