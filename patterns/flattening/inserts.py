@@ -36,6 +36,8 @@ piece 2.06 %, each insert 0.2 % (docs/garments.md).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 
 from ..cut import insert_line
@@ -48,7 +50,7 @@ from .darts import cut_darts, worst_strain
 from .remedy import Flattener, Remedy
 from .split import flat_piece, split_panel
 
-__all__ = ["is_saddle", "relieved", "slash_search", "slashed"]
+__all__ = ["is_saddle", "relieved", "relieving", "slash_search", "slashed"]
 
 _TRIES = ((0.8, 2.0), (0.9, 3.0))  # (depth towards the trough, spread of the wedges), tried in turn at each count
 _SLIVER = 1e-6  # a try whose cuts leave a triangle of less than this share of the median area is not taken
@@ -215,6 +217,18 @@ def relieved(model: Model, first: int, count: int, limit: float, flat: Flattener
         The worst strain of all the pieces (inserts included), the model with
         the inserts, and the pieces darted (where ``max_darts`` is given).
     """
+    remedy = None
+    for remedy in relieving(model, first, count, limit, flat, max_slashes=max_slashes, max_darts=max_darts):
+        pass
+    return Remedy(0.0, model, {}) if remedy is None else remedy
+
+
+def relieving(model: Model, first: int, count: int, limit: float, flat: Flattener, *, max_slashes: int,
+              max_darts: int | None = None) -> Iterator[Remedy]:
+    """:func:`relieved` a piece at a time: after each piece (the last first), the :class:`Remedy` so far (its
+    ``worst`` the worst of the pieces done).  Once that is above ``limit`` the whole cannot meet it: a search
+    may stop there and come back for the rest only if it needs the whole's strain; the last one yielded is
+    :func:`relieved`'s."""
     darted, worst = {}, 0.0
     for p in reversed(range(first, first + count)):  # an insert moves the pieces after its panel, not those before
         start = flat(model, p)
@@ -224,10 +238,11 @@ def relieved(model: Model, first: int, count: int, limit: float, flat: Flattener
             found = slash_search(model, p, piece, limit, max_slashes, start.options)
             if found is not None:
                 worst, model = max(worst, found.worst), found.model
+                yield Remedy(worst, model, dict(darted))
                 continue
         if max_darts is not None:
             darted[panel.name] = cut_darts(piece, limit, max_darts, start.held, start.options)
             piece = darted[panel.name].flattening
         worst = max(worst, worst_strain(piece))
-    return Remedy(worst, model, darted)
+        yield Remedy(worst, model, dict(darted))
 

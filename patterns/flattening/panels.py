@@ -21,7 +21,7 @@ from .engine import flatten_mesh
 from .gores import gore_search, gored
 from .grain import grain_table, turn_to_grain
 from .inserts import is_saddle, slashed
-from .parted import darts_needed, parted
+from .parted import darts_needed, parting
 from .remedy import Flattener, PanelFlat, Remedy
 from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
 from .settings import FlattenOptions
@@ -204,17 +204,13 @@ def _darted(model: Model, i: int, start: PanelFlat, opts: FlattenOptions, flat: 
         whole = cut_darts(result, limit, max_darts, start.held, start.options)
         if worst_strain(whole.flattening) <= limit:
             return Remedy(worst_strain(whole.flattening), model, {name: whole})
-    tries = []  # in the order preferred on a tie
-    pieces = parted(model, i, result, limit, max_darts, opts.max_gores, flat)
-    if pieces is not None:
-        tries.append(pieces)
-        if pieces.worst <= limit:
-            return pieces
+    pieces = parting(model, i, result, limit, max_darts, opts.max_gores, flat)  # stopped where it cannot meet it
+    if pieces is not None and pieces.met is not None:
+        return pieces.met
     gores = gore_search(model, i, result, limit, opts.max_gores, flat, max_slashes=max_darts)
-    if gores is not None:
-        tries.append(gores)
-        if gores.worst <= limit:
-            return gores
+    if gores is not None and gores.worst <= limit:
+        return gores
+    tries = [t for t in (None if pieces is None else pieces.closest(), gores) if t is not None]
     if whole is None:
         whole = cut_darts(result, limit, max_darts, start.held, start.options)
     tries.insert(0, Remedy(worst_strain(whole.flattening), model, {name: whole}))

@@ -33,17 +33,20 @@ saddle-shaped, before its darts:
 
 from __future__ import annotations
 
+from collections import deque
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..model import Model
 from ..pattern import Flattening
 from .curvature import gore_bound
 from .gores import gore_paths
-from .inserts import relieved
+from .inserts import relieving
 from .remedy import Flattener, Remedy
 from .split import split_panel
 
-__all__ = ["darts_needed", "parted"]
+__all__ = ["Parting", "darts_needed", "parted", "parting"]
 
 _PIECE_BOUND = 4.0  # a piece's share of the gore bound at most this (about 5 darts a piece)
 _COUNTS = 2  # piece counts tried: the first and one more
@@ -82,18 +85,50 @@ def parted(model: Model, index: int, result: Flattening, limit: float, max_darts
         The worst piece's strain, the parted model and its pieces darted: the first count tried that meets the
         limit, or the one that came closest; None where no count could be cut.
     """
+    found = parting(model, index, result, limit, max_darts, max_pieces, flat)
+    return None if found is None else found.met or found.closest()
+
+
+@dataclass(eq=False)
+class Parting:
+    """The piece counts :func:`parting` tried: ``met``, the first that meets the limit (None: none does);
+    the others each stopped at the first piece above it, finished only when :meth:`closest` is asked."""
+
+    tried: list
+    met: Remedy | None = None
+
+    def closest(self) -> Remedy:
+        """The count that came closest, every piece of every count done (on a tie, the fewer pieces): what
+        :func:`parted` gives where no count meets the limit."""
+        best = None
+        for k, (last, rest) in enumerate(self.tried):
+            last = next(iter(deque(rest, maxlen=1)), last)  # its other pieces done: the last yielded is the whole
+            self.tried[k] = (last, iter(()))
+            if best is None or last.worst < best.worst:
+                best = last
+        return best
+
+
+def parting(model: Model, index: int, result: Flattening, limit: float, max_darts: int, max_pieces: int,
+            flat: Flattener) -> Parting | None:
+    """:func:`parted`, with a count stopped at its first piece above the limit (it cannot meet it: every
+    piece of a count must), so that a caller with another remedy still to try (gores) finishes the counts
+    only if that one falls short too.  The pieces are the last first, as :func:`relieved` takes them.
+    None where no count could be cut."""
     first = max(3, int(np.ceil(gore_bound(result, limit) / _PIECE_BOUND)))
-    best = None
+    tried = []
     for k in range(first, min(first + _COUNTS, max_pieces + 1)):
         paths = gore_paths(result, k, limit)
         split = None if paths is None else split_panel(model, index, paths)
         if split is None:
             continue
-        found = relieved(split, index, len(split.panels) - len(model.panels) + 1, limit, flat,
-                         max_slashes=max_darts, max_darts=max_darts)
-        if best is None or found.worst < best.worst:
-            best = found
-        if found.worst <= limit:
-            break
-    return best
-
+        pieces = relieving(split, index, len(split.panels) - len(model.panels) + 1, limit, flat,
+                           max_slashes=max_darts, max_darts=max_darts)
+        done = None
+        for done in pieces:
+            if done.worst > limit:
+                break
+        else:
+            return Parting(tried, done)  # every piece within the limit
+        tried.append((done, pieces))
+    return Parting(tried) if tried else None
