@@ -405,3 +405,45 @@ def test_a_panel_that_one_dart_cannot_bring_within_the_limit_is_parted_and_the_n
     assert set(note.panels) == {p.name for p in pattern.panels} and "not met" not in note.message
     (alone,) = patterns.flatten(model, max_strain=LIMIT, max_darts=1, max_gores=0).panels
     assert len(alone.darts) <= 1 and worst(alone) > LIMIT and not alone.dart_search.met
+
+
+@pytest.mark.slow  # 24 s
+def test_a_piece_count_that_cannot_meet_the_limit_stops_early_and_finishes_to_the_same_pieces():
+    """``parting`` stops a piece count at its first piece above the limit (the count cannot meet it: every
+    piece must) and finishes it only when asked for the closest: the freeform cup at 1 % with one dart a
+    piece meets it in neither 3 nor 4 pieces; each count stopped after fewer pieces than it has, and
+    ``closest()`` is, bit for bit, the count :func:`~patterns.flattening.inserts.relieved` gives closest
+    when every piece of every count is done (on a tie the first), as ``parted`` returns it."""
+    from patterns.flattening.gores import gore_paths
+    from patterns.flattening.inserts import relieved
+    from patterns.flattening.panels import _flat_panel
+    from patterns.flattening.parted import parted, parting
+    from patterns.flattening.split import split_panel
+    from patterns.flattening.settings import FlattenOptions
+
+    limit, max_darts = 0.01, 1
+    model = patterns.load(samples.DOMES["freeform cup"]())
+    opts = FlattenOptions.of(None, {"max_strain": limit, "max_darts": max_darts}, name=model.name)
+
+    def flat(m, p):
+        return _flat_panel(m, p, opts, 0.0, {})
+
+    result = flat(model, 0).flattening
+    found = parting(model, 0, result, limit, max_darts, 24, flat)
+    assert found.met is None and len(found.tried) == 2
+    counts = []
+    for stopped, _ in found.tried:
+        n = len(stopped.model.panels)
+        assert stopped.worst > limit and len(stopped.darted) < n  # stopped before its last piece
+        counts.append(n)
+    full = []
+    for n in counts:  # every piece of each count, from scratch
+        split = split_panel(model, 0, gore_paths(result, n, limit))
+        full.append(relieved(split, 0, n, limit, flat, max_slashes=max_darts, max_darts=max_darts))
+    want = min(full, key=lambda r: r.worst)
+    got = found.closest()
+    assert got.worst == want.worst and sorted(got.darted) == sorted(want.darted)
+    for name, darted in want.darted.items():
+        assert np.array_equal(got.darted[name].flattening.uv, darted.flattening.uv)
+    again = parted(model, 0, result, limit, max_darts, 24, flat)
+    assert again.worst == want.worst
