@@ -20,7 +20,7 @@ Triangulations, each at about 1k, 10k and 100k faces (``--sizes``)
 -------------------------------------------------------------------
 * ``cad``: our CAD mesher, ``patterns.load(face, max_edge=...)``, on a build123d
   face of the exact surface, ``max_edge`` searched (a few meshings) to hit the
-  face count, with ``tolerance`` and ``angular_tolerance`` relaxed (10 mm, 1 rad)
+  face count, with ``chord_tolerance`` and ``angular_tolerance`` relaxed (10 mm, 1 rad)
   so that ``max_edge`` alone sets the size.  The cap is cut from a sphere turned
   90 degrees about x, so that the sphere's seam meridian and poles lie outside
   the cap (the face is a plain disk).  The cup is ``bd.Sphere(1)`` scaled to the
@@ -121,7 +121,7 @@ ACCEPT_LOWEST = 1.10
 CONVERGED_SPREAD = 0.03
 """At the largest size: the three triangulations' strain RMS within 3 % of each other."""
 
-CAD_TOLERANCES = {"tolerance": 10.0, "angular_tolerance": 1.0}
+CAD_TOLERANCES = {"chord_tolerance": 10.0, "angular_tolerance": 1.0}
 """Loose mesher tolerances, so that ``max_edge`` alone sets the face count."""
 
 
