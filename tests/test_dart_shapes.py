@@ -418,8 +418,8 @@ def test_a_piece_count_that_cannot_meet_the_limit_stops_early_and_finishes_to_th
     from patterns.flattening.inserts import relieved
     from patterns.flattening.panels import _flat_panel
     from patterns.flattening.parted import parted, parting
-    from patterns.flattening.split import split_panel
     from patterns.flattening.settings import FlattenOptions
+    from patterns.flattening.split import split_panel
 
     limit, max_darts = 0.01, 1
     model = patterns.load(samples.DOMES["freeform cup"]())

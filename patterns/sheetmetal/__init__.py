@@ -37,12 +37,12 @@ from ..tessellate.topology import read_topology
 from ..text import counted
 from .bends import curvatures, face_maps, group_bends
 from .contour import bend_line, clip_to, contour_faults, cut_loops, overlaps
-from .oblique import neutral_trace
 from .faces import recognise, uv_mid
 from .holes import hole_rims
 from .imported import prepared
 from .join import flat, place_faces
 from .meshed import meshed_face
+from .oblique import neutral_trace
 from .rules import manufacturability, open_contours
 from .sheet import check_volume, find_sheet
 from .table import BendTable, UnfoldOptions, read_bend_table
@@ -115,12 +115,12 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
                                  missed=missed, chains=chains)
     outline = max(loops, key=lambda lp: lp[0].area)[0]
     oblique = []  # holes across a bend with a wall not square to the sheet: drawn on the neutral layer
-    for k, ((loop, on), chain) in enumerate(zip(loops, chains)):
+    for k, ((loop, _), chain) in enumerate(zip(loops, chains)):
         retraced = None if loop is outline or chain is None else neutral_trace(
             chain, topology=topology, faces=faces, sheet=sheet, bends=bends, maps=maps, motions=motions)
         if retraced is not None:
             oblique.append((loop, retraced, sorted({e for e, _, _ in chain})))
-            loops[k] = (retraced, on)
+            loops[k] = (retraced, tuple(i for _, i, _ in chain))  # a piece per chain edge
     holes = tuple(lp for lp, _ in loops if lp is not outline)
     holes, rims = hole_rims(topology, faces, maps, motions, sheet, holes)  # countersinks: cut at the through hole
     lines = [clip_to(line, outline) for line in lines]  # a bend line ends where a corner relief cuts its zone

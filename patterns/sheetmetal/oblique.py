@@ -15,12 +15,12 @@ plane as deep in a flange), which it develops as the bend and flanges are.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..curves import Loop, Polyline
-from .bends import BendGroup
 from .faces import SheetFace, normal, point, uv_mid
 from .join import flat
 from .sheet import SheetModel
@@ -51,7 +51,7 @@ class _Junction:
         return bool((q - self.origin) @ self.side > 0 and (q - self.origin) @ self.toward > 0)
 
 
-def _ruling(wall) -> object | None:
+def _ruling(wall) -> Callable[[np.ndarray, np.ndarray], np.ndarray] | None:
     """The wall face's straight line through the sheet at a point, as a function ``(p, tangent) -> (3,)``
     (unoriented); None for a wall that has none (a spline)."""
     from OCP.BRepAdaptor import BRepAdaptor_Surface
@@ -99,17 +99,19 @@ def _samples(edge, face: SheetFace, reverse: bool) -> tuple:
     return np.array(ps), tangents / np.linalg.norm(tangents, axis=1)[:, None], np.array(uvs)
 
 
-def _uv(face: SheetFace, q: np.ndarray) -> np.ndarray:
+def _uv(face: SheetFace, q: np.ndarray, surfaces: dict) -> np.ndarray:
     """(2,) parameters of the point of ``face``'s surface nearest ``q`` (a cylinder's angle on the branch
-    nearest the face's middle)."""
+    nearest the face's middle); ``surfaces`` keeps each face's projector and middle angle, made once."""
     from OCP.BRep import BRep_Tool
     from OCP.gp import gp_Pnt
     from OCP.ShapeAnalysis import ShapeAnalysis_Surface
 
-    uv = ShapeAnalysis_Surface(BRep_Tool.Surface_s(face.face)).ValueOfUV(gp_Pnt(*map(float, q)), 1e-9)
+    if face.index not in surfaces:
+        surfaces[face.index] = (ShapeAnalysis_Surface(BRep_Tool.Surface_s(face.face)), uv_mid(face.face)[0])
+    projector, mid = surfaces[face.index]
+    uv = projector.ValueOfUV(gp_Pnt(*map(float, q)), 1e-9)
     u, v = uv.X(), uv.Y()
     if face.kind == "cylinder":
-        mid = uv_mid(face.face)[0]
         u = mid + (u - mid + np.pi) % (2 * np.pi) - np.pi
     return np.array([u, v])
 
@@ -184,6 +186,7 @@ class _Layer:
     junctions: tuple
     depth: float
     planes: dict
+    surfaces: dict = field(default_factory=dict, compare=False)  # each face's projector, made once (_uv)
 
     @classmethod
     def of(cls, groups: list, *, faces: tuple, sheet: SheetModel, bends: tuple) -> _Layer:
@@ -245,7 +248,7 @@ class _Layer:
                 past = next((x for x in self.junctions if x.bend == bend and x.past(q)), None)
                 if past is None:
                     on = face if face in self.bends[bend].faces else self.bends[bend].faces[0]
-                    return flat(maps, motions, on, _uv(self.faces[on], q)[None, :])[0]
+                    return flat(maps, motions, on, _uv(self.faces[on], q, self.surfaces)[None, :])[0]
                 bend, flange = None, past.flange
             else:
                 if flange not in self.planes:
@@ -255,6 +258,6 @@ class _Layer:
                     return None
                 back = next((x for x in self.junctions if x.flange == flange and not x.past(q)), None)
                 if back is None:
-                    return flat(maps, motions, flange, _uv(self.faces[flange], q)[None, :])[0]
+                    return flat(maps, motions, flange, _uv(self.faces[flange], q, self.surfaces)[None, :])[0]
                 bend, flange = back.bend, None
         return None
