@@ -6,12 +6,16 @@ import.  The handler remembers the signal and raises where Python is (``Keyboard
 may catch and drop what it raises there (trimesh's loaders catch ``BaseException``; an extension module
 being imported turns it into ``ImportError``), the outputs' commit asks :func:`check` before it renames a
 single file, and the command line's last word asks :func:`received`: a stop never depends on where Python
-happened to be.
+happened to be.  Where Python cannot raise it at all (inside a weak reference's callback or a ``__del__``,
+such as importlib's module-lock clean-up during the heavy imports) it prints "Exception ignored in" and a
+traceback; :func:`install` also sets an unraisable hook that keeps quiet about exactly those stops (they are
+remembered, and :func:`check` raises them again) and passes everything else to the hook there was.
 """
 
 from __future__ import annotations
 
 import signal
+import sys
 
 from .errors import Terminated
 
@@ -48,10 +52,19 @@ def install():
                     if signal.getsignal(s) is not signal.SIG_IGN}
     except ValueError:  # not the main thread
         return lambda: None
+    hook = sys.unraisablehook
+
+    def quiet(unraisable):
+        # a stop raised where Python could not let it through: remembered already, raised again by check()
+        if not (_RECEIVED and isinstance(unraisable.exc_value, (KeyboardInterrupt, Terminated))):
+            hook(unraisable)
+
+    sys.unraisablehook = quiet
 
     def restore():
         for s, handler in previous.items():
             signal.signal(s, handler)
+        sys.unraisablehook = hook
         _RECEIVED.clear()  # the run is over: a library call after it is not stopped by it
 
     return restore
