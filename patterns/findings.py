@@ -80,7 +80,9 @@ class Code(str, Enum):
     reach a flange's edge: that corner is drawn closed."""
     OBLIQUE_CUT = "oblique-cut"
     """A cut across a bend whose wall is not square to the sheet (a hole drilled after bending): drawn as the
-    wall's trace on the neutral layer, which the two faces' traces are not."""
+    wall's trace on the neutral layer, which the two faces' traces are not; or, where that cannot be traced
+    (a counterbore's step before the neutral layer, a spline wall), drawn as the fixed face's trace, saying
+    why."""
     MISSING_RELIEF = "missing-relief"
     """A bend that ends against unbent material of its blank with no relief cut there: the corner tears."""
     TINY_PART = "tiny-part"

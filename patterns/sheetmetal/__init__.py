@@ -120,7 +120,8 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
             chain, topology=topology, faces=faces, sheet=sheet, bends=bends, maps=maps, motions=motions)
         if retraced is not None:
             oblique.append((loop, retraced, sorted({e for e, _, _ in chain})))
-            loops[k] = (retraced, tuple(i for _, i, _ in chain))  # a piece per chain edge
+            if retraced.loop is not None:
+                loops[k] = (retraced.loop, retraced.faces)
     holes = tuple(lp for lp, _ in loops if lp is not outline)
     holes, rims = hole_rims(topology, faces, maps, motions, sheet, holes)  # countersinks: cut at the through hole
     lines = [clip_to(line, outline) for line in lines]  # a bend line ends where a corner relief cuts its zone
@@ -137,10 +138,14 @@ def unfold(shape_or_path, options: UnfoldOptions | None = None, *, name: str | N
                          f"{name}: bend at faces {', '.join(map(str, bend.faces))} has no flat face on one side")
                  for bend, group in zip(drawn, bends) if not group.flanged]
     findings += [Finding(
-        Code.OBLIQUE_CUT, Severity.NOTE, (name,), retraced.vertices()[:, :2].mean(axis=0)[None, :], (), None,
-        f"{name}: the cut at edges {', '.join(map(str, edges))} crosses a bend with its wall not square to the "
-        f"sheet (drilled after bending): drawn as the wall's trace on the neutral layer, {retraced.area:.2f} mm² "
-        f"(the fixed face's trace {skin.area:.2f} mm²)") for skin, retraced, edges in oblique]
+        Code.OBLIQUE_CUT, Severity.NOTE, (name,), (retraced.loop or skin).vertices()[:, :2].mean(axis=0)[None, :], (),
+        None, f"{name}: the cut at edges {', '.join(map(str, edges))} crosses a bend with its wall not square to the "
+        f"sheet (drilled after bending): " + (
+            f"drawn as the wall's trace on the neutral layer, {retraced.loop.area:.2f} mm² (the fixed face's trace "
+            f"{skin.area:.2f} mm²)" if retraced.loop is not None else
+            f"drawn as the fixed face's trace, {skin.area:.2f} mm², not on the neutral layer: {retraced.why}; the "
+            f"hole cut in the blank and bent will not be the model's"))
+        for skin, retraced, edges in oblique]
     if missed:
         findings.append(Finding(
             Code.RELIEF_NOT_DRAWN, Severity.NOTE, (name,), np.array(missed), (), None,

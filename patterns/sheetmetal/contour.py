@@ -20,7 +20,7 @@ from .bends import BendGroup
 from .corners import is_bend_end, treat_corners
 from .join import flat
 
-__all__ = ["CUSP_DEGREES", "bend_line", "clip_to", "contour_faults", "cut_loops", "overlaps"]
+__all__ = ["CUSP_DEGREES", "bend_line", "clip_to", "contour_faults", "cut_loops", "edge_parameters", "edge_piece", "overlaps"]
 
 CUSP_DEGREES = 30.0
 """A corner of the cut contour sharper than this (degrees) is a cusp: a spike of material a laser burns, or a
@@ -32,10 +32,9 @@ SAMPLE = 0.001
 """Chord error of curved pieces sampled as polylines, mm."""
 
 
-def _piece(edge, face: int, maps: dict, motions: dict, flip: bool):
+def edge_piece(edge, face: int, maps: dict, motions: dict, flip: bool):
     """One boundary edge of a skin face as an exact piece on the blank, walked as the face's wire walks it."""
-    from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
-    from OCP.GCPnts import GCPnts_QuasiUniformDeflection
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
     from OCP.GeomAbs import GeomAbs_Circle, GeomAbs_Line
 
     fmap = maps[face]
@@ -64,15 +63,22 @@ def _piece(edge, face: int, maps: dict, motions: dict, flip: bool):
         u, w = a - c, q - c
         sweep = abs(t1 - t0) * np.sign(u[0] * w[1] - u[1] * w[0])
         return Arc(c, float(circ.Radius()), float(np.arctan2(*(a - c)[::-1])), float(sweep))
+    return Polyline(at(edge_parameters(edge, SAMPLE, reverse=flip)))
+
+
+def edge_parameters(edge, deflection: float, *, reverse: bool) -> np.ndarray:
+    """(k,) float64 parameters of an edge's 3D curve, its ends included, whose chord error is at most
+    ``deflection`` mm; in the walk's direction (``reverse``: from the curve's last parameter)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.GCPnts import GCPnts_QuasiUniformDeflection
+
     curve = BRepAdaptor_Curve(edge)
-    sampler = GCPnts_QuasiUniformDeflection(curve, SAMPLE)
+    sampler = GCPnts_QuasiUniformDeflection(curve, deflection)
     ts = [sampler.Parameter(k) for k in range(1, sampler.NbPoints() + 1)] if sampler.IsDone() else []
     if len(ts) < 2:
         ts = np.linspace(curve.FirstParameter(), curve.LastParameter(), 65)
-    ts = np.sort(np.asarray(ts))
-    if flip:
-        ts = ts[::-1]
-    return Polyline(at(ts))
+    ts = np.sort(np.asarray(ts, dtype=np.float64))
+    return ts[::-1] if reverse else ts
 
 
 def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, name: str, *, relief: str = "none",
@@ -103,7 +109,7 @@ def cut_loops(topology: Topology, maps: dict, motions: dict, skin: frozenset, na
                     continue
                 flip = edge.Orientation() == TopAbs_REVERSED
                 a, b = topology.edge_vertices[e][::-1] if flip else topology.edge_vertices[e]
-                piece = _piece(edge, i, maps, motions, flip)
+                piece = edge_piece(edge, i, maps, motions, flip)
                 by_start.setdefault(a, []).append((b, (piece, i, is_bend_end(piece, maps[i].kind)), (e, i, flip)))
     loops, gaps = [], []
     ends = {b for chain in by_start.values() for b, _, _ in chain}
@@ -215,7 +221,7 @@ def overlaps(topology: Topology, maps: dict, motions: dict, skin: frozenset, gap
     for i in sorted(skin):
         rings = []
         for wire in topology.wires[i]:
-            pts = [_piece(edge, i, maps, motions, edge.Orientation() == TopAbs_REVERSED).points(0.01)[:-1]
+            pts = [edge_piece(edge, i, maps, motions, edge.Orientation() == TopAbs_REVERSED).points(0.01)[:-1]
                    for e, edge in wire if not topology.degenerate[e]]
             if pts:
                 rings.append(np.concatenate(pts))

@@ -7,96 +7,157 @@ shapes (85 and 114 mm² for a 10 mm hole across a 90-degree bend of a 1.5 mm
 sheet).  The blank is cut flat and then bent, and only the neutral layer keeps
 its length in the bend: the hole to cut is the wall's trace on the neutral
 layer, developed.  :func:`neutral_trace` finds it point by point: from each
-point of the fixed face's trace, along the wall's straight line through the
-sheet (a drilled cylinder's axis, a cone's generator, a plane's line square to
-the cut edge), to the neutral layer (the neutral cylinder in the bend, the
-plane as deep in a flange), which it develops as the bend and flanges are.
+point of the fixed face's trace, along a straight line of the wall through the
+sheet (a drilled cylinder's axis, a cone's generator; on a plane, the
+direction of its own edges across the sheet at the two ends, turned from one
+to the other along the cut), to the first point of the neutral layer (the
+neutral cylinder within each bend's angle, the plane as deep as that bend's
+neutral layer under each flange), which it develops as the bend and flanges
+are.  A cut edge whose trace lies within :data:`SQUARE` of the fixed face's on
+the blank is square to the sheet and keeps its exact piece (a line, an arc).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+import shapely
 
 from ..curves import Loop, Polyline
+from .contour import edge_parameters, edge_piece
 from .faces import SheetFace, normal, point, uv_mid
 from .join import flat
 from .sheet import SheetModel
 
-__all__ = ["SQUARE", "neutral_trace"]
+__all__ = ["SAMPLE", "SQUARE", "Oblique", "neutral_trace"]
 
-SQUARE = 1e-9
-"""A wall whose straight line through the sheet is within this of the sheet's normal (``1 - |cos|``) at
-every point of a cut is square to the sheet: the cut is drawn from the fixed face, exact lines and arcs."""
-SAMPLE = 0.0001
+SQUARE = 0.001
+"""A cut edge whose neutral-layer trace lies within this of the fixed face's trace on the blank (mm, each way)
+is square to the sheet: drawn from the fixed face, its exact line or arc.  A cut is redrawn only when one of its
+edges is further off: a wall tilted by 0.04 degrees in a 1.5 mm sheet moves it 0.001 mm."""
+SAMPLE = 0.00002
 """Chord error of the fixed face's trace sampled for an oblique cut, mm."""
+STEEP = 0.05
+"""A wall whose line through the sheet runs within this of the sheet's plane (the cosine of its angle to the
+sheet's normal) is not traced: its trace on the neutral layer is too far from the face's to be one cut."""
+
+
+@dataclass(frozen=True)
+class Oblique:
+    """A cut across a bend with a wall not square to the sheet.
+
+    Attributes
+    ----------
+    loop : patterns.curves.Loop or None
+        The cut redrawn: each cut edge as its trace on the neutral layer (a polyline, mm), or its exact piece
+        where that is square; None where it could not be traced (``why``).
+    faces : tuple of int
+        The skin face of each piece of ``loop``.
+    why : str
+        Why it was not traced ("" when it was): its wall has no straight line through the sheet, changes
+        within the sheet (a counterbore or a countersink), or runs nearly along it.
+    """
+
+    loop: Loop | None
+    faces: tuple
+    why: str = ""
 
 
 @dataclass(frozen=True)
 class _Junction:
-    """Where a bend meets a flange: the plane through the bend's axis square to the flange; ``side`` (3,)
-    points from it along the flange, ``toward`` (3,) from the axis to the flange's plane.  A point is past
-    the junction, in the flange, when it is ahead of the axis along both (a bend of 180 degrees or more has
-    both its junctions in one plane, on either side of the axis)."""
+    """Where bend ``bend`` meets flange ``flange``: ``side`` (3,) points from the plane through the bend's axis
+    square to the flange along the flange; the flange's neutral plane lies ``depth`` mm under its skin
+    (``origin`` (3,), outward ``normal`` (3,)), as deep as the bend's neutral cylinder under the bend's skin."""
 
     bend: int
     flange: int
-    origin: np.ndarray
+    axis_point: np.ndarray
     side: np.ndarray
-    toward: np.ndarray
+    origin: np.ndarray
+    normal: np.ndarray
+    depth: float
 
-    def past(self, q: np.ndarray) -> bool:
-        return bool((q - self.origin) @ self.side > 0 and (q - self.origin) @ self.toward > 0)
+    def on_flange(self, q: np.ndarray) -> bool:
+        return bool((q - self.axis_point) @ self.side >= -1e-9)
 
 
-def _ruling(wall) -> Callable[[np.ndarray, np.ndarray], np.ndarray] | None:
-    """The wall face's straight line through the sheet at a point, as a function ``(p, tangent) -> (3,)``
-    (unoriented); None for a wall that has none (a spline)."""
-    from OCP.BRepAdaptor import BRepAdaptor_Surface
-    from OCP.GeomAbs import GeomAbs_Cone, GeomAbs_Cylinder, GeomAbs_Plane
+def _across(topology, wall: int, skin: frozenset, at: np.ndarray, inward: np.ndarray) -> np.ndarray | None:
+    """(3,) the direction into the sheet of plane ``wall``'s edge across the sheet (on no skin face) that
+    starts at ``at``: the wall's own line across the sheet there; None when it has none."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.gp import gp_Pnt, gp_Vec
 
-    s = BRepAdaptor_Surface(wall)
-    kind = s.GetType()
-    if kind == GeomAbs_Cylinder:
-        d = s.Cylinder().Axis().Direction()
-        axis = np.array([d.X(), d.Y(), d.Z()])
-        return lambda p, tangent: axis
-    if kind == GeomAbs_Cone:
-        a = s.Cone().Apex()
-        apex = np.array([a.X(), a.Y(), a.Z()])
-        return lambda p, tangent: (p - apex) / np.linalg.norm(p - apex)
-    if kind == GeomAbs_Plane:
-        d = s.Plane().Axis().Direction()
-        n = np.array([d.X(), d.Y(), d.Z()])
-        return lambda p, tangent: np.cross(n, tangent) / np.linalg.norm(np.cross(n, tangent))
+    for wire in topology.wires[wall]:
+        for f, edge in wire:
+            if topology.degenerate[f] or any(k in skin for k in topology.edge_faces[f]):
+                continue
+            curve = BRepAdaptor_Curve(edge)
+            for t in (curve.FirstParameter(), curve.LastParameter()):
+                p, d = gp_Pnt(), gp_Vec()
+                curve.D1(t, p, d)
+                if np.linalg.norm(np.array([p.X(), p.Y(), p.Z()]) - at) < 1e-6 and d.Magnitude() > 1e-12:
+                    v = np.array([d.X(), d.Y(), d.Z()]) / d.Magnitude()
+                    return v if v @ inward > 0 else -v
     return None
 
 
+def _rulings(topology, faces: tuple, skin: frozenset, wall: int, run: list) -> list | None:
+    """The wall's straight lines through the sheet at the points of a run of cut edges along it: per edge of
+    ``run`` (``[((k, 3) points, (k, 3) inward normals), ...]``, in the loop's order), (k, 3) unit directions
+    into the sheet; None for a wall with none (a spline surface).  A plane's lines turn from its edge across
+    the sheet at the run's start to the one at its end, evenly along the run."""
+    f = faces[wall]
+    ps, inward = np.vstack([p for p, _ in run]), np.vstack([n for _, n in run])
+    if f.kind == "cylinder":
+        rays = np.broadcast_to(f.axis, ps.shape).copy()
+    elif f.kind == "cone":
+        a = f.adaptor.Cone().Apex()
+        rays = ps - np.array([a.X(), a.Y(), a.Z()])
+    elif f.kind == "plane":
+        n = normal(f, *uv_mid(f.face))
+        ends = [_across(topology, wall, skin, ps[j], inward[j]) for j in (0, -1)]
+        # no edge across the sheet at an end (a closed edge): the plane's line nearest the sheet's normal there
+        ends = [v if v is not None else inward[j] - (inward[j] @ n) * n for v, j in zip(ends, (0, -1))]
+        along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ps, axis=0), axis=1))])
+        lam = (along / along[-1] if along[-1] > 0 else np.zeros(len(ps)))[:, None]
+        rays = (1 - lam) * ends[0] + lam * ends[1]
+        rays -= (rays @ n)[:, None] * n  # in the plane
+    else:
+        return None
+    rays *= np.sign(np.einsum("ij,ij->i", rays, inward))[:, None]
+    length = np.linalg.norm(rays, axis=1)
+    if np.any(length < 1e-12):
+        return None
+    rays /= length[:, None]
+    return np.split(rays, np.cumsum([len(p) for p, _ in run])[:-1])
+
+
+def _runs(walls: list) -> list:
+    """The chain's edge numbers grouped into runs of consecutive edges along one wall face, in order (a run
+    may go on from the last edge to the first)."""
+    n = len(walls)
+    start = next((k for k in range(n) if walls[k] != walls[k - 1]), 0)
+    runs: list = []
+    for k in range(start, start + n):
+        if runs and walls[k % n] == walls[runs[-1][-1]]:
+            runs[-1].append(k % n)
+        else:
+            runs.append([k % n])
+    return runs
+
+
 def _samples(edge, face: SheetFace, reverse: bool) -> tuple:
-    """(k, 3) points, (k, 3) unit tangents and (k, 2) parameters on ``face`` along a skin edge, in the
-    loop's direction."""
+    """(k, 3) points and (k, 2) parameters on ``face`` along a cut edge, in the loop's direction."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
-    from OCP.GCPnts import GCPnts_QuasiUniformDeflection
-    from OCP.gp import gp_Pnt, gp_Vec
 
     curve, c2 = BRepAdaptor_Curve(edge), BRepAdaptor_Curve2d(edge, face.face)
-    sampler = GCPnts_QuasiUniformDeflection(curve, SAMPLE)
-    ts = [sampler.Parameter(k) for k in range(1, sampler.NbPoints() + 1)] if sampler.IsDone() else []
-    ts = np.unique(np.concatenate([ts, [curve.FirstParameter(), curve.LastParameter()]]))
-    if reverse:
-        ts = ts[::-1]
-    ps, tangents, uvs = [], [], []
-    for t in ts:
-        p, d = gp_Pnt(), gp_Vec()
-        curve.D1(float(t), p, d)
-        q = c2.Value(float(t))
+    ps, uvs = [], []
+    for t in edge_parameters(edge, SAMPLE, reverse=reverse):
+        p, q = curve.Value(float(t)), c2.Value(float(t))
         ps.append((p.X(), p.Y(), p.Z()))
-        tangents.append((d.X(), d.Y(), d.Z()))
         uvs.append((q.X(), q.Y()))
-    tangents = np.array(tangents)
-    return np.array(ps), tangents / np.linalg.norm(tangents, axis=1)[:, None], np.array(uvs)
+    return np.array(ps), np.array(uvs)
 
 
 def _uv(face: SheetFace, q: np.ndarray, surfaces: dict) -> np.ndarray:
@@ -116,15 +177,69 @@ def _uv(face: SheetFace, q: np.ndarray, surfaces: dict) -> np.ndarray:
     return np.array([u, v])
 
 
+def _holds(face: SheetFace, q: np.ndarray, surfaces: dict) -> bool:
+    """Whether ``q`` (3,) lies on the bounded face (its surface's nearest point within 1e-6 mm, in its
+    boundary or on it)."""
+    from OCP.BRepClass import BRepClass_FaceClassifier
+    from OCP.gp import gp_Pnt2d
+    from OCP.TopAbs import TopAbs_IN, TopAbs_ON
+
+    uv = _uv(face, q, surfaces)
+    if np.linalg.norm(point(face, *uv) - q) > 1e-6:
+        return False
+    state = BRepClass_FaceClassifier(face.face, gp_Pnt2d(*map(float, uv)), 1e-6).State()
+    return state in (TopAbs_IN, TopAbs_ON)
+
+
+def _square_wall(face: SheetFace, ps: np.ndarray, inward: np.ndarray, thickness: float, surfaces: dict) -> bool:
+    """Whether a wall with no straight line through the sheet is square to it at every point ``ps`` (k, 3):
+    tilted so little that across the sheet it moves less than :data:`SQUARE`."""
+    for p, n in zip(ps, inward):
+        m = normal(face, *_uv(face, p, surfaces))
+        c = abs(float(m @ n))
+        if c >= 1 or thickness * c / np.sqrt(1 - c * c) > SQUARE:
+            return False
+    return True
+
+
+def _traced(run: list, wall: int, *, chain: tuple, samples: list, inwards: list, topology, faces: tuple,
+            sheet: SheetModel, layer: _Layer, maps: dict, motions: dict) -> list | str:
+    """Per chain edge of ``run`` (consecutive edges along one wall face), the (k, 2) blank positions of its
+    wall's trace on the neutral layer (mm), or all None where the run's trace lies within :data:`SQUARE` of the
+    fixed face's (square to the sheet); a str saying why the run cannot be traced."""
+    ps_run = [samples[k][0] for k in run]
+    rays = _rulings(topology, faces, sheet.skin, wall, [(samples[k][0], inwards[k]) for k in run])
+    if rays is None:
+        if all(_square_wall(faces[wall], samples[k][0], inwards[k], sheet.thickness, layer.surfaces) for k in run):
+            return [None] * len(run)
+        return "its wall has no straight line through the sheet (a spline surface)"
+    if min(float(np.min(np.einsum("ij,ij->i", r, inwards[k]))) for k, r in zip(run, rays)) < STEEP:
+        return "its wall runs nearly along the sheet"
+    traced = []
+    for ps, ds in zip(ps_run, rays):
+        edge = []
+        for p, d in zip(ps, ds):
+            found = layer.neutral(p, d, sheet.thickness / STEEP)
+            if found is None or not _holds(faces[wall], found[0], layer.surfaces):
+                return "its wall changes within the sheet (a counterbore or a countersink: a step before the neutral layer)"
+            edge.append(layer.developed(*found, maps=maps, motions=motions))
+        traced.append(np.array(edge))
+    skin = np.vstack([flat(maps, motions, chain[k][1], samples[k][1]) for k in run])
+    drawn = np.vstack(traced)
+    off = max(float(np.max(shapely.distance(shapely.points(drawn), shapely.LineString(skin)))),
+              float(np.max(shapely.distance(shapely.points(skin), shapely.LineString(drawn)))))
+    return [None] * len(run) if off <= SQUARE else traced
+
+
 def neutral_trace(chain: tuple, *, topology, faces: tuple, sheet: SheetModel, bends: tuple, maps: dict,
-                  motions: dict) -> Loop | None:
+                  motions: dict) -> Oblique | None:
     """A closed cut contour redrawn on the neutral layer, when it crosses a bend and its wall is not square
     to the sheet.
 
     Parameters
     ----------
     chain : tuple of (int, int, bool)
-        The loop's skin edges in order: ``(edge, skin face, reversed)`` (:func:`~patterns.sheetmetal.contour.
+        The loop's cut edges in order: ``(edge, skin face, reversed)`` (:func:`~patterns.sheetmetal.contour.
         cut_loops`' ``chains``).
     topology : patterns.tessellate.topology.Topology
     faces : tuple of SheetFace
@@ -137,43 +252,45 @@ def neutral_trace(chain: tuple, *, topology, faces: tuple, sheet: SheetModel, be
 
     Returns
     -------
-    patterns.curves.Loop or None
-        One polyline per edge of ``chain`` through the developed neutral-layer points (mm, the loop's
-        direction kept); None where the cut is drawn as it is: it crosses no cylindrical bend, its wall is
-        square to the sheet, or a wall has no straight line through the sheet (a spline) or one that misses
-        the neutral layer.
+    Oblique or None
+        The cut redrawn (the loop's direction kept, one piece per edge of ``chain``), or why it could not be;
+        None where the cut is drawn as it is: it crosses no cylindrical bend, or every edge is square to the
+        sheet (:data:`SQUARE`).
     """
     touched = {i for _, i, _ in chain}
     groups = [k for k, g in enumerate(bends) if g.kind == "cylinder" and touched & set(g.faces)]
     if not groups or any(faces[i].kind not in ("plane", "cylinder") for i in touched):
         return None
     walls = []
-    for e, i, _ in chain:
+    for e, _, _ in chain:
         rims = [f for f in topology.edge_faces[e] if f not in sheet.skin]
-        ruling = _ruling(topology.faces[rims[0]]) if len(rims) == 1 else None
-        if ruling is None:
+        if len(rims) != 1:
             return None
-        walls.append(ruling)
+        walls.append(rims[0])
     samples = [_samples(topology.edges[e], faces[i], reverse) for e, i, reverse in chain]
-    inward = [-np.array([normal(faces[i], *uv) for uv in uvs]) for (_, i, _), (_, _, uvs) in zip(chain, samples)]
-    rays = [np.array([ruling(p, t) for p, t in zip(ps, ts)]) for ruling, (ps, ts, _) in zip(walls, samples)]
-    rays = [r * np.sign(np.einsum("ij,ij->i", r, n))[:, None] for r, n in zip(rays, inward)]
-    if max(float(np.max(1 - np.einsum("ij,ij->i", r, n))) for r, n in zip(rays, inward)) < SQUARE:
-        return None
+    inwards = [-np.array([normal(faces[i], *uv) for uv in uvs]) for (_, i, _), (_, uvs) in zip(chain, samples)]
     layer = _Layer.of(groups, faces=faces, sheet=sheet, bends=bends)
-    pieces, last = [], None
-    for (_, i, _), (ps, _, _), ray in zip(chain, samples, rays):
-        pts = [layer.developed(p, d, i, maps=maps, motions=motions) for p, d in zip(ps, ray)]
-        if any(q is None for q in pts):
-            return None
-        pts = np.array(pts)
-        if last is not None:
-            pts[0] = last
-        last = pts[-1]
-        pieces.append(Polyline(pts))
-    first = pieces[0].points()
-    pieces[0] = Polyline(np.vstack([last[None, :], first[1:]]))
-    return Loop(tuple(pieces))
+    pieces: list = [None] * len(chain)  # (piece, square) per chain edge
+    for run in _runs(walls):
+        wall = walls[run[0]]
+        got = _traced(run, wall, chain=chain, samples=samples, inwards=inwards, topology=topology, faces=faces,
+                      sheet=sheet, layer=layer, maps=maps, motions=motions)
+        if isinstance(got, str):
+            return Oblique(None, (), got)
+        for k, traced in zip(run, got):
+            e, i, reverse = chain[k]
+            pieces[k] = (edge_piece(topology.edges[e], i, maps, motions, reverse), True) if traced is None else \
+                (Polyline(traced), False)
+    if all(square for _, square in pieces):
+        return None
+    out = [piece for piece, _ in pieces]
+    for k, (piece, square) in enumerate(pieces):  # a polyline ends where an exact piece after it starts
+        if not square and pieces[(k + 1) % len(pieces)][1]:
+            out[k] = Polyline(np.vstack([piece.points()[:-1], out[(k + 1) % len(out)].points()[:1]]))
+    for k, (piece, square) in enumerate(pieces):  # and starts where the piece before it ends
+        if not square:
+            out[k] = Polyline(np.vstack([out[k - 1].points()[-1:], out[k].points()[1:]]))
+    return Oblique(Loop(tuple(out)), tuple(i for _, i, _ in chain))
 
 
 @dataclass(frozen=True)
@@ -184,80 +301,89 @@ class _Layer:
     bends: tuple
     groups: tuple
     junctions: tuple
-    depth: float
-    planes: dict
+    spans: dict
     surfaces: dict = field(default_factory=dict, compare=False)  # each face's projector, made once (_uv)
 
     @classmethod
     def of(cls, groups: list, *, faces: tuple, sheet: SheetModel, bends: tuple) -> _Layer:
-        junctions = []
+        from OCP.BRepTools import BRepTools
+
+        junctions, spans = [], {}
         for k in groups:
-            f = faces[bends[k].faces[0]]
             for j in bends[k].faces:
+                f = faces[j]
+                u0, u1, _, _ = BRepTools.UVBounds_s(f.face)
+                spans[j] = (u0, u1)
                 for b, _ in sheet.neighbours[j]:
                     if b in sheet.skin and faces[b].kind == "plane" and b not in {x.flange for x in junctions
                                                                                    if x.bend == k}:
-                        n, m = normal(faces[b], *uv_mid(faces[b].face)), point(faces[b], *uv_mid(faces[b].face))
-                        origin = np.asarray(f.origin, dtype=np.float64)
+                        uv = uv_mid(faces[b].face)
+                        n, m = normal(faces[b], *uv), point(faces[b], *uv)
+                        axis_point = np.asarray(f.origin, dtype=np.float64)
                         side = np.cross(f.axis, n)
                         side /= np.linalg.norm(side)
-                        side = side if (m - origin) @ side > 0 else -side
-                        toward = n if (m - origin) @ n > 0 else -n
-                        junctions.append(_Junction(k, b, origin, side, toward))
-        first = bends[groups[0]]
-        depth = abs(faces[first.faces[0]].radius - first.neutral_radius)  # a flange's neutral plane under its skin
-        planes = {}
-        for i in sorted(sheet.skin):
-            if faces[i].kind == "plane":
-                uv = uv_mid(faces[i].face)
-                planes[i] = (point(faces[i], *uv), normal(faces[i], *uv))
-        return cls(faces, bends, tuple(groups), tuple(junctions), depth, planes)
+                        side = side if (m - axis_point) @ side > 0 else -side
+                        depth = abs(f.radius - bends[k].neutral_radius)  # the bend's neutral layer under this skin
+                        junctions.append(_Junction(k, b, axis_point, side, m, n, depth))
+        return cls(faces, bends, tuple(groups), tuple(junctions), spans)
 
-    def _on_bend(self, k: int, p: np.ndarray, d: np.ndarray) -> np.ndarray | None:
-        """The first point ahead of ``p`` along ``d`` on bend ``k``'s neutral cylinder."""
+    def _on_bend(self, k: int, p: np.ndarray, d: np.ndarray) -> list:
+        """``[(s, q, face), ...]``: where the line ``p + s d`` (s > 0) meets bend ``k``'s neutral cylinder
+        within the bend's angle (``face`` the bend face whose angles hold it)."""
         f, rn = self.faces[self.bends[k].faces[0]], self.bends[k].neutral_radius
         a = f.axis
-        r0, dd = p - f.origin, d.copy()
-        r0, dd = r0 - (r0 @ a) * a, dd - (dd @ a) * a
+        r0, dd = p - f.origin, d - (d @ a) * a
+        r0 = r0 - (r0 @ a) * a
         qa, qb, qc = dd @ dd, r0 @ dd, r0 @ r0 - rn * rn
         disc = qb * qb - qa * qc
-        if qa <= 0 or disc < 0:
-            return None
-        roots = sorted(((-qb - np.sqrt(disc)) / qa, (-qb + np.sqrt(disc)) / qa))
-        s = next((r for r in roots if r > -1e-9), None)
-        return None if s is None else p + s * d
+        if qa <= 1e-24 or disc < 0:
+            return []
+        found = []
+        for s in sorted(((-qb - np.sqrt(disc)) / qa, (-qb + np.sqrt(disc)) / qa)):
+            if s > -1e-9:
+                q = p + s * d
+                on = next((j for j in self.bends[k].faces
+                           if self.spans[j][0] - 1e-9 <= _uv(self.faces[j], q, self.surfaces)[0] <= self.spans[j][1]
+                           + 1e-9), None)
+                if on is not None:
+                    found.append((float(s), q, on))
+        return found
 
-    def _on_flange(self, b: int, p: np.ndarray, d: np.ndarray) -> np.ndarray | None:
-        """The point along ``d`` from ``p`` on flange ``b``'s neutral plane."""
-        origin, n = self.planes[b]
-        across = -(d @ n)
+    def _on_flange(self, b: int, p: np.ndarray, d: np.ndarray) -> list:
+        """``[(s, q, b)]``: where the line ``p + s d`` (s > 0) meets flange ``b``'s neutral plane on the flange's
+        side of each of its junctions.  Under a flange between two bends whose neutral layers lie at different
+        depths under its skin (a jog's web at K other than 0.5), the depth goes from one to the other evenly
+        across the flange: the layer is continuous with both bends'."""
+        xs = [x for x in self.junctions if x.flange == b]
+        x = xs[0]
+        slope = np.zeros(3)
+        if len(xs) == 2 and abs(xs[1].depth - x.depth) > 1e-12:
+            width = float((xs[1].axis_point - x.axis_point) @ x.side)
+            if width > 1e-9:
+                slope = (xs[1].depth - x.depth) / width * x.side  # depth(q) = x.depth + slope @ (q - x.axis_point)
+        elif len(xs) > 2:
+            x = min(xs, key=lambda y: float(np.linalg.norm(p - y.axis_point)))  # the nearest bend's depth
+        m = x.normal + slope
+        across = -(d @ m)
         if across <= 1e-12:
-            return None
-        return p + (self.depth + (p - origin) @ n) / across * d
+            return []
+        s = ((p - x.origin) @ x.normal + x.depth + slope @ (p - x.axis_point)) / across
+        q = p + s * d
+        if s <= -1e-9 or not all(y.on_flange(q) for y in xs):
+            return []
+        return [(float(s), q, b)]
 
-    def developed(self, p: np.ndarray, d: np.ndarray, face: int, *, maps: dict, motions: dict) -> np.ndarray | None:
-        """(2,) the blank position of the neutral-layer point of the wall's line from ``p`` (on skin face
-        ``face``) along ``d`` into the sheet, mm; None where it cannot be found."""
-        bend = next((k for k in self.groups if face in self.bends[k].faces), None)
-        flange = face if bend is None else None
-        for _ in range(4):  # bend -> flange -> bend ... settles in two
-            if bend is not None:
-                q = self._on_bend(bend, p, d)
-                if q is None:
-                    return None
-                past = next((x for x in self.junctions if x.bend == bend and x.past(q)), None)
-                if past is None:
-                    on = face if face in self.bends[bend].faces else self.bends[bend].faces[0]
-                    return flat(maps, motions, on, _uv(self.faces[on], q, self.surfaces)[None, :])[0]
-                bend, flange = None, past.flange
-            else:
-                if flange not in self.planes:
-                    return None
-                q = self._on_flange(flange, p, d)
-                if q is None:
-                    return None
-                back = next((x for x in self.junctions if x.flange == flange and not x.past(q)), None)
-                if back is None:
-                    return flat(maps, motions, flange, _uv(self.faces[flange], q, self.surfaces)[None, :])[0]
-                bend, flange = back.bend, None
-        return None
+    def neutral(self, p: np.ndarray, d: np.ndarray, reach: float) -> tuple | None:
+        """``(q, face)``: the first point of the neutral layer on the line from ``p`` (on the skin) along ``d``
+        (into the sheet), not further than ``reach`` mm, and the skin face it develops with; None if none."""
+        found = [hit for k in self.groups for hit in self._on_bend(k, p, d)]
+        found += [hit for b in sorted({x.flange for x in self.junctions}) for hit in self._on_flange(b, p, d)]
+        found = [hit for hit in found if hit[0] <= reach]
+        if not found:
+            return None
+        _, q, face = min(found, key=lambda hit: (hit[0], hit[2]))  # ties (a junction): the lower face number
+        return q, face
+
+    def developed(self, q: np.ndarray, face: int, *, maps: dict, motions: dict) -> np.ndarray:
+        """(2,) the blank position of the neutral-layer point ``q`` (3,) over skin face ``face``, mm."""
+        return flat(maps, motions, face, _uv(self.faces[face], q, self.surfaces)[None, :])[0]
