@@ -24,10 +24,12 @@ def _constant(script: str, name: str):
 
 
 def test_the_refinement_studys_mesher_tolerances_are_options_load_takes():
-    """``refinement.py``'s ``CAD_TOLERANCES`` go to ``patterns.load`` with ``max_edge``: a 100 mm square
-    meshed with them and ``max_edge`` 10 has its area, 10,000 mm²."""
+    """``refinement.py``'s ``CAD_TOLERANCES`` go to ``patterns.load`` with ``max_edge``, loose "so that
+    ``max_edge`` alone sets the face count": ``load`` takes them (a renamed key raises), and they bite: a
+    cylinder R 20 x 40 meshed with them and ``max_edge`` 10 has under a fifth of the triangles the default
+    tolerances give it (their chord error, not ``max_edge``, sets that mesh)."""
     tolerances = _constant("refinement.py", "CAD_TOLERANCES")
-    (face,) = bd.Rectangle(100, 100).faces()
-    model = patterns.load(face, max_edge=10.0, **tolerances)
-    (panel,) = model.panels
-    assert abs(panel.area - 10_000.0) < 1e-6
+    face = bd.Cylinder(20, 40).faces().filter_by(bd.GeomType.CYLINDER)[0]
+    (loose,) = patterns.load(face, max_edge=10.0, **tolerances).panels
+    (default,) = patterns.load(face, max_edge=10.0).panels
+    assert 5 * len(loose.faces) < len(default.faces)

@@ -1,6 +1,8 @@
 """Darts on curved shapes other than spheres (issue 36): the surface's curvature, and a report that
 never says the limit was met when it was not."""
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -405,6 +407,24 @@ def test_a_panel_that_one_dart_cannot_bring_within_the_limit_is_parted_and_the_n
     assert set(note.panels) == {p.name for p in pattern.panels} and "not met" not in note.message
     (alone,) = patterns.flatten(model, max_strain=LIMIT, max_darts=1, max_gores=0).panels
     assert len(alone.darts) <= 1 and worst(alone) > LIMIT and not alone.dart_search.met
+
+
+def test_progress_moves_through_the_search_and_never_back():
+    """``flatten(progress=)`` while the freeform cup is parted into pieces with a dart each: every call is
+    ``(done, total)`` in floats of the model's one panel, never back, ending at ``(1, 1)``; the search (the
+    first half of the bar) moves with each flattening it makes (the dartless panel, then each piece): past
+    ``k / (k + 1)`` of its half once ``k`` are done, so past ``(n - 1) / n`` of it by the last of ``n``
+    pieces (within the bar's 0.001 step); and the pieces are bit for bit those of a run with no progress."""
+    model = patterns.load(samples.DOMES["freeform cup"]())
+    calls = []
+    pattern = patterns.flatten(model, max_strain=LIMIT, max_darts=1, progress=lambda d, n: calls.append((d, n)))
+    assert all(type(d) is float and n == 1.0 for d, n in calls) and calls[-1] == (1.0, 1.0)
+    assert all(a[0] < b[0] for a, b in itertools.pairwise(calls))
+    n = len(pattern.panels)  # n flattenings done as the last piece starts: the dartless panel and n - 1 pieces
+    assert n >= 3 and max(d for d, _ in calls if d < 0.5) >= 0.5 * (n - 1) / n
+    plain = patterns.flatten(model, max_strain=LIMIT, max_darts=1)
+    for a, b in zip(pattern.panels, plain.panels, strict=True):
+        assert np.array_equal(a.flattening.uv, b.flattening.uv) and np.array_equal(a.flattening.faces, b.flattening.faces)
 
 
 @pytest.mark.slow  # 24 s

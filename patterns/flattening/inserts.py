@@ -225,10 +225,31 @@ def relieved(model: Model, first: int, count: int, limit: float, flat: Flattener
 
 def relieving(model: Model, first: int, count: int, limit: float, flat: Flattener, *, max_slashes: int,
               max_darts: int | None = None) -> Iterator[Remedy]:
-    """:func:`relieved` a piece at a time: after each piece (the last first), the :class:`Remedy` so far (its
-    ``worst`` the worst of the pieces done).  Once that is above ``limit`` the whole cannot meet it: a search
-    may stop there and come back for the rest only if it needs the whole's strain; the last one yielded is
-    :func:`relieved`'s."""
+    """:func:`relieved` a piece at a time, so that a search can stop at the first piece above the limit.
+
+    Parameters
+    ----------
+    model : Model
+        The split model; not changed (a slash makes a new one).
+    first, count : int
+        Its pieces: panels ``first`` to ``first + count - 1``, relieved the last first (an insert moves the
+        panels after its own, never those before).
+    limit : float
+        The area-weighted principal strain each piece must meet (a fraction: 0.03 is 3 %).
+    flat : Flattener
+        Flattens one panel of a model (the caller's options).
+    max_slashes : int
+        Slashes a saddle-shaped piece may get (0: none).
+    max_darts : int or None
+        Darts per piece; None: none cut.
+
+    Yields
+    ------
+    Remedy
+        After each piece, the remedy so far: ``worst`` the worst strain of the pieces done, the model (with any
+        slash), each darted piece's darts.  Once ``worst`` is above ``limit`` the whole cannot meet it; the last
+        one yielded is :func:`relieved`'s.
+    """
     darted, worst = {}, 0.0
     for p in reversed(range(first, first + count)):  # an insert moves the pieces after its panel, not those before
         start = flat(model, p)

@@ -22,6 +22,7 @@ from .gores import gore_search, gored
 from .grain import grain_table, turn_to_grain
 from .inserts import is_saddle, slashed
 from .parted import darts_needed, parting
+from .progress import Bar
 from .remedy import Flattener, PanelFlat, Remedy
 from .seams import SeamLengths, held_lengths, seam_edges, validate_ease
 from .settings import FlattenOptions
@@ -79,7 +80,11 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
           1e-5, a pattern is relaxed to convergence), ``min_stretch``,
           ``energy`` (``"auto"``): the relaxation, see :func:`flatten_mesh`.
     progress : callable, optional
-        ``progress(panels_done, n_panels)`` after each panel.
+        ``progress(done, total)``: how far it is, ``done`` (float) of ``total`` (float: the model's panel
+        count), never back; after each panel, and within one as its flattening's iterations go.  Where
+        ``max_strain`` splits panels (parts and darts them, or gores), the first half of the bar is that
+        search, a share per panel, moving with every flattening it makes (how many is not known before:
+        ``k / (k + 1)`` of the share after ``k``); the second half the pieces.
 
     Returns
     -------
@@ -104,15 +109,22 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
     eased = validate_ease(opts.ease, model)
     mode = SeamLengths(opts.seams)
     darted = {}  # panel name -> Darted: darted while the panels were split
+    bar = None if progress is None else Bar(progress, len(model.panels))
+    first = 0.0  # where the panels' part of the bar starts
     if max_strain is not None:
         keep = {model.seams[s].panels[side] for s, side in eased}  # an eased seam's panel keeps its name
-        model, darted = _split(model, opts, offset, keep)
+        first = len(model.panels) / 2
+        model, darted = _split(model, opts, offset, keep, bar)
         eased = validate_ease(opts.ease, model)
+    tick = None if bar is None else bar.engine
     grains = grain_table(opts.grain, model)
     eased_panels = {model.seams[s].panels[side] for s, side in eased}
     flat, targets = [], {}
     no_darts = {name for p in model.panels if p.insert_into is not None for name in (p.name, p.insert_into)}
     for i, panel in enumerate(model.panels):
+        if bar is not None:
+            share = (bar.total - first) / len(model.panels)
+            bar.span(first + i * share, first + (i + 1) * share)
         darts, search = (), None
         if opts.exact and panel.surface is not None and i not in eased_panels:
             result = developed(panel, offset, f"{model.name}: panel {panel.name}")
@@ -120,7 +132,7 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
             got = darted[panel.name]
             result, darts, search = got.flattening, got.darts, got.search
         else:
-            start = _flat_panel(model, i, opts, offset, eased)
+            start = _flat_panel(model, i, opts, offset, eased, tick=tick)
             result = start.flattening
             if max_strain is not None and not opts.gores and panel.name not in no_darts:  # slashed, or an insert
                 got = cut_darts(result, max_strain, max_darts, start.held, start.options)
@@ -129,8 +141,8 @@ def flatten(model, options: FlattenOptions | None = None, *, progress=None, **ke
         if panel.name in grains:
             result = turn_to_grain(result, grains[panel.name])
         flat.append(FlatPanel(panel.name, panel, result, darts=darts, dart_search=search))
-        if progress is not None:
-            progress(i + 1, len(model.panels))
+    if bar is not None:
+        bar.finish()
     seams_out = []
     edges = [unique_edges(fp.faces) for fp in flat]  # once per panel, not per seam side
     for seam in model.seams:
@@ -148,39 +160,48 @@ def _engine_options(opts: FlattenOptions, name: str) -> dict:
             "min_stretch": opts.min_stretch, "energy": opts.energy, "name": name}
 
 
-def _flat_panel(model: Model, i: int, opts: FlattenOptions, offset: float, eased) -> PanelFlat:
+def _flat_panel(model: Model, i: int, opts: FlattenOptions, offset: float, eased, *, tick=None) -> PanelFlat:
     """Panel ``i`` by the mesh engine (its neutral surface where ``offset``), its seams held as ``opts.seams``
-    says (with the ``eased`` sides' ease), and the keywords of :func:`flatten_mesh` it was flattened with."""
+    says (with the ``eased`` sides' ease), and the keywords of :func:`flatten_mesh` it was flattened with
+    (``tick`` its ``progress``, kept for the flattenings of its darts and pieces)."""
     panel = model.panels[i]
     vertices = offset_along_normals(panel, offset) if offset else panel.vertices
     held = None
     if opts.method == "relaxed":
         held = held_lengths(model, i, vertices, eased, SeamLengths(opts.seams), mesh_edges=unique_edges(panel.faces))
     options = _engine_options(opts, f"{model.name}: panel {panel.name}")
+    if tick is not None:
+        options["progress"] = tick
     return PanelFlat(flatten_mesh(vertices, panel.faces, lengths=held, **options), held, options)
 
 
-def _split(model: Model, opts: FlattenOptions, offset: float, keep: set) -> tuple:
+def _split(model: Model, opts: FlattenOptions, offset: float, keep: set, bar: Bar | None = None) -> tuple:
     """``max_strain``: every freeform panel above the limit split into gores (``gores=True``, :mod:`.gores`),
     or, if saddle-shaped, slashed and given inserts (:mod:`.inserts`), or else darted, and parted into pieces
     with darts where darts alone fall short (:func:`_darted`; not with ``max_gores`` 0: darted later).
 
     Panels are taken last to first, so that a split does not move the
     panels still to be looked at.  Returns the model and ``{panel name:
-    Darted}`` of the panels darted here.
+    Darted}`` of the panels darted here.  ``bar``: each panel's search fills
+    its share of the bar's first half.
     """
+    tick = None if bar is None else bar.engine
+
     def flat(m: Model, p: int) -> PanelFlat:  # a piece of a split panel, flattened as the panels are
-        return _flat_panel(m, p, opts, offset, {})
+        return _flat_panel(m, p, opts, offset, {}, tick=tick)
 
     darted = {}
-    for i in reversed(range(len(model.panels))):
+    n = len(model.panels)
+    for i in reversed(range(n)):
+        if bar is not None:
+            bar.span((n - 1 - i) / 2, (n - i) / 2)
         panel = model.panels[i]
         if (opts.exact and panel.surface is not None) or opts.method != "relaxed" or i in keep:
             continue
         saddle = is_saddle(panel.vertices, panel.faces, panel.loops)
         if not (opts.gores or saddle or opts.max_gores):
             continue
-        start = _flat_panel(model, i, opts, offset, {})
+        start = _flat_panel(model, i, opts, offset, {}, tick=tick)
         if opts.gores:
             model = gored(model, i, start.flattening, opts.max_strain, opts.max_gores, flat, max_slashes=opts.max_darts)
         elif saddle:

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -89,21 +90,32 @@ def parted(model: Model, index: int, result: Flattening, limit: float, max_darts
     return None if found is None else found.met or found.closest()
 
 
-@dataclass(eq=False)
+@dataclass(frozen=True, eq=False)
 class Parting:
-    """The piece counts :func:`parting` tried: ``met``, the first that meets the limit (None: none does);
-    the others each stopped at the first piece above it, finished only when :meth:`closest` is asked."""
+    """The piece counts :func:`parting` tried.
 
-    tried: list
+    Attributes
+    ----------
+    tried : tuple of (Remedy, Iterator[Remedy])
+        Each count that missed the limit: where it stopped (its first piece above it) and the rest of its
+        pieces, not yet done (:func:`~patterns.flattening.inserts.relieving`'s iterator).
+    met : Remedy or None
+        The first count that meets the limit; None where none does.
+    """
+
+    tried: tuple
     met: Remedy | None = None
+
+    @cached_property
+    def _finished(self) -> tuple:
+        """Each count of ``tried`` with its other pieces done, once: the last each iterator yields is the whole."""
+        return tuple(next(iter(deque(rest, maxlen=1)), last) for last, rest in self.tried)
 
     def closest(self) -> Remedy:
         """The count that came closest, every piece of every count done (on a tie, the fewer pieces): what
         :func:`parted` gives where no count meets the limit."""
         best = None
-        for k, (last, rest) in enumerate(self.tried):
-            last = next(iter(deque(rest, maxlen=1)), last)  # its other pieces done: the last yielded is the whole
-            self.tried[k] = (last, iter(()))
+        for last in self._finished:
             if best is None or last.worst < best.worst:
                 best = last
         return best
@@ -129,6 +141,6 @@ def parting(model: Model, index: int, result: Flattening, limit: float, max_dart
             if done.worst > limit:
                 break
         else:
-            return Parting(tried, done)  # every piece within the limit
+            return Parting(tuple(tried), done)  # every piece within the limit
         tried.append((done, pieces))
-    return Parting(tried) if tried else None
+    return Parting(tuple(tried)) if tried else None
