@@ -512,10 +512,8 @@ def _split_faces(faces: np.ndarray, point_of: dict, uv: np.ndarray) -> np.ndarra
     lo, hi = np.minimum(faces, np.roll(faces, -1, axis=1)), np.maximum(faces, np.roll(faces, -1, axis=1))
     keys = np.array([a * n + b for a, b in point_of], dtype=np.int64)  # side k of a face runs corner k -> k + 1
     touched = np.flatnonzero(np.isin(lo * n + hi, keys).any(axis=1))
-    out, kept_from = [], 0
+    plans = []  # per face crossed: (index, [triangles]) or (index, (kept, first, second)) to choose from
     for i, face in zip(touched.tolist(), faces[touched].tolist()):
-        out.append(faces[kept_from:i])  # the faces before this one, in their order
-        kept_from = i + 1
         marks = []
         for k in range(3):
             x, y = face[k], face[(k + 1) % 3]
@@ -525,37 +523,62 @@ def _split_faces(faces: np.ndarray, point_of: dict, uv: np.ndarray) -> np.ndarra
         if len(marks) == 1:
             (k, pt), = marks
             x, y, z = face[k], face[(k + 1) % 3], face[(k + 2) % 3]
-            out.append(np.array([[x, pt, z], [pt, y, z]]))
+            plans.append((i, [[x, pt, z], [pt, y, z]]))
         elif len(marks) == 2:
             (k1, p1), (k2, p2) = marks
             if k2 != (k1 + 1) % 3:  # the points lie on edges k2 and k1: start from the earlier
                 (k1, p1), (k2, p2) = (k2, p2), (k1, p1)
             x, y, z = face[k1], face[(k1 + 1) % 3], face[(k1 + 2) % 3]  # p1 on x-y, p2 on y-z
-            first = [[x, p1, p2], [x, p2, z]]
-            second = [[x, p1, z], [p1, p2, z]]
-            out.append(np.array([[p1, y, p2], *max(first, second, key=lambda tris: min(_min_angle(uv[t]) for t in tris))]))
+            plans.append((i, ([p1, y, p2], [[x, p1, p2], [x, p2, z]], [[x, p1, z], [p1, p2, z]])))
         else:  # a straight line crosses a triangle's sides at most twice
             raise MeshTopologyError("a straight line crossed all three sides of a triangle")
+    choices = [tris for _, tris in plans if isinstance(tris, tuple)]
+    # the quad beside the point on two sides split by the diagonal that keeps the larger smallest angle
+    # (the first on a tie): every candidate's angles at once
+    angles = _min_angles(uv[np.array([t for _, first, second in choices for t in (*first, *second)],
+                                     dtype=np.int64).reshape(-1, 3)]) if choices else np.zeros(0)
+    out, kept_from, c = [], 0, 0
+    for i, tris in plans:
+        out.append(faces[kept_from:i])  # the faces before this one, in their order
+        kept_from = i + 1
+        if isinstance(tris, tuple):
+            kept, first, second = tris
+            a = min(angles[4 * c], angles[4 * c + 1])
+            b = min(angles[4 * c + 2], angles[4 * c + 3])
+            c += 1
+            tris = [kept, *(second if b > a else first)]
+        out.append(np.array(tris))
     out.append(faces[kept_from:])
     return np.concatenate(out).astype(np.int64).reshape(-1, 3)
 
 
-def _min_angle(points: np.ndarray) -> float:
-    """Smallest corner angle of one triangle (radians)."""
-    s = np.roll(points, -1, axis=0) - points
-    lengths = np.linalg.norm(s, axis=1)
-    cos = -(s * np.roll(s, 1, axis=0)).sum(axis=1) / np.maximum(lengths * np.roll(lengths, 1), 1e-300)
-    return float(np.arccos(np.clip(cos, -1.0, 1.0)).min())
+def _min_angles(points: np.ndarray) -> np.ndarray:
+    """Smallest corner angle of each triangle ``points`` (k, 3, 2), radians (k,)."""
+    s = np.roll(points, -1, axis=1) - points
+    lengths = np.linalg.norm(s, axis=2)
+    cos = -(s * np.roll(s, 1, axis=1)).sum(axis=2) / np.maximum(lengths * np.roll(lengths, 1, axis=1), 1e-300)
+    return np.arccos(np.clip(cos, -1.0, 1.0)).min(axis=1)
 
 
 def _joined(stops: np.ndarray, faces: np.ndarray, n: int, vertices: np.ndarray) -> np.ndarray:
     """The stops in order, joined by the shortest edge path wherever two in a row share no edge."""
     edges = unique_edges(faces)
-    known = set(map(tuple, edges.tolist()))
+    # whether each two stops in a row share an edge, all at once (a set of every edge's pair took a dart
+    # search a third of its cutting time): sorted int64 keys, as unique_edges orders them
+    size = max(n, int(faces.max()) + 1 if len(faces) else 1, int(np.max(stops)) + 1 if len(stops) else 1)
+    keys = edges[:, 0] * size + edges[:, 1]
+
+    def adjacent(a, b):  # (k,) int64 each: whether a[i]-b[i] is an edge
+        key = np.minimum(a, b).astype(np.int64) * size + np.maximum(a, b).astype(np.int64)
+        at = np.minimum(np.searchsorted(keys, key), max(len(keys) - 1, 0))
+        return (keys[at] == key) if len(keys) else np.zeros(len(key), dtype=bool)
+
+    near = adjacent(stops[:-1], stops[1:])
     path = [int(stops[0])] if len(stops) else []
     graph = None
-    for nxt in stops[1:].tolist():
-        if (min(path[-1], nxt), max(path[-1], nxt)) in known:
+    for k, nxt in enumerate(stops[1:].tolist()):
+        # path[-1] is the stop before, but where a shortest path found no way to it
+        if near[k] if path[-1] == stops[k] else adjacent(np.array([path[-1]]), np.array([nxt]))[0]:
             path.append(nxt)
             continue
         if graph is None:

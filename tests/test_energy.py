@@ -127,3 +127,32 @@ def test_the_dirichlet_weights_are_the_cotangent_laplacian(cap):
             cot = (a @ b) / np.linalg.norm(np.cross(a, b))
             expected[conn.face_edges[t, k]] += 0.5 * cot / area.mean()
     np.testing.assert_allclose(weight, expected, rtol=1e-9, atol=1e-12 * np.abs(expected).max())
+
+
+def test_a_value_without_its_gradient_is_the_same_to_the_last_bit(cap):
+    """The line search tests most steps by their value alone (``grad=False``; the relaxation's
+    ``_Objective.value``): the value must be the one the full evaluation gives, bit for bit, or a step taken
+    would change with the order of the tests.  Every energy, the guard, the seam term and the barrier at
+    ``mu`` 0 and 0.1, on the cap moved at random and with a triangle turned over (inf)."""
+    from patterns.flattening.relax import _Objective
+
+    v, f, conn, uv = cap
+    fr = frames(v, f)
+    e = conn.edges[conn.boundary_edges][:12]
+    target = np.linalg.norm(v[e[:, 1]] - v[e[:, 0]], axis=1) * 1.01
+    folded = uv.copy()
+    folded[f[0][0]], folded[f[0][1]] = uv[f[0][1]], uv[f[0][0]]
+    for make in (Arap, SymmetricDirichlet, Hybrid):
+        for guard in (None, InverseTerm(fr, 1.5)):
+            seam = EdgeLengths(len(v), e, target, np.repeat(np.arange(3), 4), np.array([1.0, 2.0, 3.0]), 30.0)
+            seam.lam = np.array([0.3, -0.2, 0.1])
+            objective = _Objective(make(fr), InverseTerm(fr), guard, seam)
+            for layout in (uv, folded):
+                for mu in (0.0, 0.1):
+                    f_value, f_grad, b_value, b_grad = objective.parts(layout, mu)
+                    full = np.inf if f_grad is None or (mu > 0 and b_grad is None) else \
+                        f_value if mu == 0 else f_value + mu * b_value
+                    assert objective.value(layout, mu) == full
+                jac = fr.jacobian(layout)
+                alone, both = make(fr).terms(jac, grad=False), make(fr).terms(jac)
+                assert (alone is None and both is None) or (alone[0] == both[0] and alone[1] is None)

@@ -220,16 +220,18 @@ class _TriangleEnergy:
     def __init__(self, fr: Frames):
         self.fr = fr
 
-    def terms(self, jac: Jacobian):  # pragma: no cover - abstract
+    def terms(self, jac: Jacobian, *, grad: bool = True):  # pragma: no cover - abstract
+        """``(value, dE/dJ entries)``, the entries None where not ``grad``; None where folded."""
         raise NotImplementedError
 
-    def __call__(self, u: np.ndarray, jac: Jacobian | None = None):
-        """``(value, gradient (n, 2))``; ``(inf, None)`` where the energy sees a folded triangle."""
-        out = self.terms(self.fr.jacobian(u) if jac is None else jac)
+    def __call__(self, u: np.ndarray, jac: Jacobian | None = None, *, grad: bool = True):
+        """``(value, gradient (n, 2))``; ``(inf, None)`` where the energy sees a folded triangle; the gradient
+        None where not ``grad`` (the value the same to the last bit)."""
+        out = self.terms(self.fr.jacobian(u) if jac is None else jac, grad=grad)
         if out is None:
             return np.inf, None
         value, derivative = out
-        return value, self.fr.gradient(*derivative)
+        return value, self.fr.gradient(*derivative) if grad else None
 
 
 class Arap(_TriangleEnergy):
@@ -244,12 +246,14 @@ class Arap(_TriangleEnergy):
     name = "arap"
     stretch = (1.0, 0.0)  # (p, q) of the per-stretch term, see _TriangleEnergy
 
-    def terms(self, jac):
+    def terms(self, jac, *, grad=True):
         ar, ai, br, bi = jac.conformal_parts()
         size = np.hypot(ar, ai)
         excess = size - 1.0
         w = self.fr.weight
         value = 2.0 * dot(w, excess * excess + br * br + bi * bi)
+        if not grad:
+            return value, None
         # 2 W (J - R), R = [[ar, -ai], [ai, ar]] / |alpha|.
         k = 2.0 * w * excess / np.maximum(size, 1e-300)
         w2 = 2.0 * w
@@ -274,7 +278,7 @@ class SymmetricDirichlet(_TriangleEnergy):
     name = "symmetric-dirichlet"
     stretch = (0.0, 1.0)
 
-    def terms(self, jac):
+    def terms(self, jac, *, grad=True):
         det = jac.det
         if not np.all(det > 0):
             return None
@@ -282,6 +286,8 @@ class SymmetricDirichlet(_TriangleEnergy):
         t1, t2 = e1 * (e1 + 2.0) / (e1 + 1.0), e2 * (e2 + 2.0) / (e2 + 1.0)
         w = self.fr.weight
         value = dot(w, t1 * t1 + t2 * t2)
+        if not grad:
+            return value, None
         m11, m12, m21, m22 = jac.inverse_transpose_cubed(det)
         w2 = 2.0 * w
         return value, (w2 * (jac.j11 - m11), w2 * (jac.j12 - m12), w2 * (jac.j21 - m21), w2 * (jac.j22 - m22))
@@ -304,12 +310,14 @@ class Hybrid(_TriangleEnergy):
         super().__init__(fr)
         self._arap, self._sd = Arap(fr), SymmetricDirichlet(fr)
 
-    def terms(self, jac):
-        sd = self._sd.terms(jac)
+    def terms(self, jac, *, grad=True):
+        sd = self._sd.terms(jac, grad=grad)
         if sd is None:
             return None
-        arap = self._arap.terms(jac)
+        arap = self._arap.terms(jac, grad=grad)
         a, b = self.stretch
+        if not grad:
+            return a * arap[0] + b * sd[0], None
         return a * arap[0] + b * sd[0], tuple(a * x + b * y for x, y in zip(arap[1], sd[1]))
 
 
@@ -326,7 +334,7 @@ class InverseTerm(_TriangleEnergy):
         super().__init__(fr)
         self.floor = float(floor)
 
-    def terms(self, jac):
+    def terms(self, jac, *, grad=True):
         det = jac.det
         if not np.all(det > 0):
             return None
@@ -339,6 +347,8 @@ class InverseTerm(_TriangleEnergy):
         else:
             value = dot(w, inv2)
             k = -2.0 * w
+        if not grad:
+            return value, None
         m11, m12, m21, m22 = jac.inverse_transpose_cubed(det)
         return value, (k * m11, k * m12, k * m21, k * m22)
 
@@ -397,10 +407,12 @@ class EdgeLengths:
         """``c_g``, ``(g,)``: each group's flat length over its target, minus 1."""
         return np.bincount(self.group, self._lengths(u)[2], len(self.weight)) / self.total - 1.0
 
-    def __call__(self, u: np.ndarray, jac=None):
+    def __call__(self, u: np.ndarray, jac=None, *, grad: bool = True):
         dx, dy, length = self._lengths(u)
         c = np.bincount(self.group, length, len(self.weight)) / self.total - 1.0
         value = dot(self.weight, self.lam * c + 0.5 * self.rho * c * c)
+        if not grad:
+            return value, None
         force = self.weight * (self.lam + self.rho * c) / self.total  # dE/d(sum of lengths), per group
         k = force[self.group] / np.maximum(length, 1e-300)
         return value, self._scatter @ np.column_stack([k * dx, k * dy])

@@ -138,7 +138,7 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
     energy = BY_NAME[energy](fr)
     uv = np.array(uv, dtype=np.float64)
     jac = fr.jacobian(uv)
-    value = energy.terms(jac)[0]
+    value = energy.terms(jac, grad=False)[0]
     size = layout_size(uv)
     used = 0
     for used in range(1, iterations + 1):
@@ -159,7 +159,7 @@ def reweighted(fr: Frames, uv: np.ndarray, loops, *, energy: str = "symmetric-di
         while step > smallest:
             cand = uv + step * direction
             cand_jac = fr.jacobian(cand)
-            terms = energy.terms(cand_jac)
+            terms = energy.terms(cand_jac, grad=False)  # values only
             if terms is not None and terms[0] < value:
                 if not outline_valid(cand, loops):
                     return Carried(uv, used, True)  # the step would run the outline into itself
