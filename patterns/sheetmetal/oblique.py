@@ -30,7 +30,7 @@ from .faces import SheetFace, normal, point, uv_mid
 from .join import flat
 from .sheet import SheetModel
 
-__all__ = ["SAMPLE", "SQUARE", "Oblique", "neutral_trace"]
+__all__ = ["SAMPLE", "SQUARE", "STEEP", "Oblique", "neutral_trace"]
 
 SQUARE = 0.001
 """A cut edge whose neutral-layer trace lies within this of the fixed face's trace on the blank (mm, each way)
