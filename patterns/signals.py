@@ -31,6 +31,10 @@ _RECEIVED: list = []
 _COMMITTED: list = []
 """The outputs renamed onto their targets since :func:`install` (:func:`committed`)."""
 
+_DEPTH: list = []
+"""One entry per :func:`install` not yet restored: a run's own install inside another's (the launcher's, then
+the command line's) is the same run, and keeps what was received before it."""
+
 
 def _handler(signum, frame):
     _RECEIVED.append(signum)
@@ -40,11 +44,14 @@ def _handler(signum, frame):
 
 
 def install():
-    """Handle SIGINT and SIGTERM as above (forgetting earlier ones; one ignored stays ignored); returns a function that puts back the
-    handlers there were.  Outside the main thread (a test harness, a host's worker thread) nothing is
-    installed and the function does nothing."""
-    _RECEIVED.clear()
-    _COMMITTED.clear()
+    """Handle SIGINT and SIGTERM as above (one ignored stays ignored); returns a function that puts back the
+    handlers there were.  A new run forgets the stops of earlier ones; an install inside another (the launcher's,
+    then :func:`patterns.cli.main`'s) is the same run and keeps a stop received between the two, such as one
+    quieted during the heavy imports.  Outside the main thread (a test harness, a host's worker thread) nothing
+    is installed and the function does nothing."""
+    if not _DEPTH:
+        _RECEIVED.clear()
+        _COMMITTED.clear()
     try:
         # a signal the process was started ignoring stays ignored (nohup, a shell's background job: as Python
         # itself leaves SIGINT then)
@@ -60,12 +67,17 @@ def install():
             hook(unraisable)
 
     sys.unraisablehook = quiet
+    _DEPTH.append(quiet)
 
     def restore():
         for s, handler in previous.items():
             signal.signal(s, handler)
-        sys.unraisablehook = hook
-        _RECEIVED.clear()  # the run is over: a library call after it is not stopped by it
+        if sys.unraisablehook is quiet:  # a hook someone set after ours stays theirs
+            sys.unraisablehook = hook
+        if quiet in _DEPTH:
+            _DEPTH.remove(quiet)
+        if not _DEPTH:
+            _RECEIVED.clear()  # the run is over: a library call after it is not stopped by it
 
     return restore
 

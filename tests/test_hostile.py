@@ -314,6 +314,44 @@ thing = Thing(); ref = weakref.ref(thing, stop); del thing
     assert "ValueError: another error" in run.stderr and word in run.stderr.splitlines()[-1], run.stderr
 
 
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_stop_quieted_during_the_heavy_imports_is_not_forgotten_by_the_run(tmp_path, sig):
+    """The ``patterns`` command installs the handlers (patterns.launch), imports the command line, whose main()
+    installs them again for its run.  A stop that lands where Python cannot raise while patterns.cli is being
+    imported (a weak reference's callback, as importlib's module-lock clean-up is) is quieted and remembered:
+    here, for real, in a fresh interpreter running the command's own entry point on a sample, the signal sent
+    from such a callback as patterns.cli's import starts (an audit hook).  The run ends as stopped, in one line,
+    and writes nothing (it used to forget the stop at the second install: exit 0, out.dxf written)."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "out.dxf"
+    script = f"""
+import os, signal, sys, weakref
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as a user's shell gives it (.ci/run & ignores it)
+class Thing:
+    pass
+def stop(ref):
+    os.kill(os.getpid(), signal.{sig})
+    for _ in range(1000):  # the handler runs between bytecodes: here, inside the callback
+        pass
+fired = []
+def hook(event, args):
+    if event == "import" and args[0] == "patterns.cli" and not fired:
+        fired.append(1)
+        thing = Thing(); ref = weakref.ref(thing, stop); del thing
+sys.addaudithook(hook)
+from patterns.launch import main
+sys.argv = ["patterns", "unfold", {str(SAMPLES / "bracket.step")!r}, "-o", {str(out)!r}]
+sys.exit(main())
+"""
+    run = subprocess.run([sys.executable, "-c", script], check=False, capture_output=True, text=True, timeout=300)
+    word = "interrupted" if sig == "SIGINT" else "terminated"
+    assert run.returncode == (130 if sig == "SIGINT" else 143), run.stderr
+    assert run.stderr.splitlines() == [f"patterns: {word}; nothing written"], run.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
 def test_a_signal_at_any_moment_ends_the_run_in_one_line(strip, sig):
