@@ -427,6 +427,29 @@ def test_progress_moves_through_the_search_and_never_back():
         assert np.array_equal(a.flattening.uv, b.flattening.uv) and np.array_equal(a.flattening.faces, b.flattening.faces)
 
 
+def test_every_flattening_moves_the_bar_however_few_its_iterations():
+    """The bar counts a stage's flattenings by the engine's call as each starts (``progress(0, 1)``), not by its
+    share dropping: three real flattenings of one iteration each in one stage (each ends at share 1, so the
+    share never drops) fill it to ``k / (k + 1)`` after ``k`` = 3 (3/4 of the span), and a fourth stage's
+    flattening starts from its own span's foot; the bar was at 1/2 after the three when only a drop counted."""
+    from patterns.flattening.engine import flatten_mesh
+    from patterns.flattening.progress import Bar
+    from patterns.surfaces import paraboloid_dish
+
+    vertices, faces = paraboloid_dish(n_faces=200)
+    calls = []
+    bar = Bar(lambda d, n: calls.append(d), 4)
+    bar.span(0.0, 2.0)
+    for _ in range(3):
+        flatten_mesh(vertices, faces, max_iterations=1, progress=bar.engine)
+    assert calls[-1] == pytest.approx(2.0 * 3 / 4, abs=1e-12)
+    bar.span(2.0, 4.0)
+    flatten_mesh(vertices, faces, max_iterations=1, progress=bar.engine)
+    assert calls[-1] == pytest.approx(2.0 + 2.0 * 1 / 2, abs=1e-12)
+    bar.finish()
+    assert calls[-1] == 4.0 and all(a < b for a, b in itertools.pairwise(calls))
+
+
 @pytest.mark.slow  # 24 s
 def test_a_piece_count_that_cannot_meet_the_limit_stops_early_and_finishes_to_the_same_pieces():
     """``parting`` stops a piece count at its first piece above the limit (the count cannot meet it: every

@@ -102,8 +102,9 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
         was added: :mod:`patterns.flattening.darts` sews a dart's legs from
         the layout they fell into when cut).
     progress : callable, optional
-        Called as ``progress(n_done, n_total)``: vertices placed by a grower,
-        then iterations of the relaxation.
+        Called as ``progress(n_done, n_total)``: first ``progress(0, 1)`` as
+        the flattening starts, then vertices placed by a grower (``n_done``
+        at least 1), then iterations of the relaxation (from 1).
     name : str
         How the mesh is named in error messages.
 
@@ -150,6 +151,8 @@ def flatten_mesh(vertices, faces, *, method: str = "relaxed", seed_face: int | N
     wv, wf = (v, f) if num is None else (v[num.vertex], num.faces)
     seed = grow.seed_face(wv, wf, conn) if seed_face is None else int(seed_face if num is None
                                                                          else num.face_inverse[seed_face])
+    if progress is not None:
+        progress(0, 1)  # a flattening starts (patterns.flattening.progress counts them by this)
     with threadpool_limits(limits=1, user_api="blas"):
         # One BLAS thread: a sum split between threads rounds differently, and the
         # pattern must not depend on the machine's thread count.

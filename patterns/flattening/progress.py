@@ -3,9 +3,10 @@
 A model's panels are flattened one by one, each by one relaxation; where ``max_strain`` parts and darts a
 panel, a search flattens it, or its pieces, tens of times first, and how many times is not known before it
 ends.  :class:`Bar` gives each stage its span of the bar (``total`` is the model's panel count): the span
-fills as the flattenings inside it go (the engine's own ``progress(iteration, max_iterations)``): to ``k / (k + 1)`` of it after ``k``
-flattenings (a half after one, nine tenths after nine), so that a long search moves with every flattening
-it makes; it is full when the stage ends.
+fills as the flattenings inside it go (the engine's own ``progress``: ``(0, 1)`` as a flattening starts, then
+``(iteration, max_iterations)``): to ``k / (k + 1)`` of it after ``k`` flattenings (a half after one, nine
+tenths after nine), so that a long search moves with every flattening it makes, however few iterations each
+takes; it is full when the stage ends.
 """
 
 from __future__ import annotations
@@ -33,22 +34,23 @@ class Bar:
     def __init__(self, progress: Callable[[float, float], object], total: int):
         self._progress, self.total = progress, float(total)
         self._lo = self._hi = self._told = 0.0
-        self._runs, self._last = 0, 0.0
+        self._runs, self._share, self._started = 0, 0.0, False
 
     def span(self, lo: float, hi: float) -> None:
         """The next stage fills the bar from ``lo`` to ``hi`` (of ``total``); the stage before is done."""
         self._tell(self._hi, force=True)
         self._lo, self._hi = max(lo, self._hi), max(hi, self._hi)
-        self._runs, self._last = 0, 0.0
+        self._runs, self._share, self._started = 0, 0.0, False
 
     def engine(self, done: float, total: float) -> None:
-        """The engine's ``progress``: a flattening's iteration ``done`` of ``total``; a smaller share than
-        the call before starts the next flattening of the stage."""
-        share = min(max(done / total, 0.0), 1.0) if total > 0 else 1.0
-        if share < self._last:
-            self._runs += 1
-        self._last = share
-        work = self._runs + share  # flattenings done, and the share of this one
+        """The engine's ``progress``: ``done`` 0 as a flattening starts (the stage's next one, after the
+        first), then its iteration ``done`` of ``total``."""
+        if done <= 0:
+            self._runs += self._started
+            self._share, self._started = 0.0, True
+        else:
+            self._share = max(self._share, min(done / total, 1.0) if total > 0 else 1.0)
+        work = self._runs + self._share  # flattenings done, and the share of this one
         self._tell(self._lo + (self._hi - self._lo) * work / (work + 1.0))
 
     def finish(self) -> None:

@@ -12,9 +12,12 @@ sheet (a drilled cylinder's axis, a cone's generator; on a plane, the
 direction of its own edges across the sheet at the two ends, turned from one
 to the other along the cut), to the first point of the neutral layer (the
 neutral cylinder within each bend's angle, the plane as deep as that bend's
-neutral layer under each flange), which it develops as the bend and flanges
-are.  A cut edge whose trace lies within :data:`SQUARE` of the fixed face's on
-the blank is square to the sheet and keeps its exact piece (a line, an arc).
+neutral layer under each flange, ending at the flange's bends), which it
+develops as the bend and flanges are; between samples the developed trace is
+refined until it bows no more than :data:`SAMPLE`.  A cut edge whose trace lies
+within :data:`SQUARE` of the fixed face's on the blank is square to the sheet
+and keeps its exact piece (a line, an arc); a cut on flanges only is traced
+when its tilted wall reaches a bend under the skin.
 """
 
 from __future__ import annotations
@@ -30,14 +33,19 @@ from .faces import SheetFace, normal, point, uv_mid
 from .join import flat
 from .sheet import SheetModel
 
-__all__ = ["SAMPLE", "SQUARE", "STEEP", "Oblique", "neutral_trace"]
+__all__ = ["LOOK", "ROUNDS", "SAMPLE", "SQUARE", "STEEP", "Oblique", "neutral_trace"]
 
 SQUARE = 0.001
 """A cut edge whose neutral-layer trace lies within this of the fixed face's trace on the blank (mm, each way)
 is square to the sheet: drawn from the fixed face, its exact line or arc.  A cut is redrawn only when one of its
 edges is further off: a wall tilted by 0.04 degrees in a 1.5 mm sheet moves it 0.001 mm."""
 SAMPLE = 0.00002
-"""Chord error of the fixed face's trace sampled for an oblique cut, mm."""
+"""Chord error of an oblique cut's trace, mm: of the fixed face's trace as sampled, and of the developed neutral
+trace between its samples (halved where it bows more, up to :data:`ROUNDS` times)."""
+ROUNDS = 24
+"""How many times an oblique cut's samples are halved where its developed trace bows."""
+LOOK = 0.01
+"""Chord error of the first look at a cut (is its wall square to the sheet; does it reach a bend), mm."""
 STEEP = 0.05
 """A wall whose line through the sheet runs within this of the sheet's plane (the cosine of its angle to the
 sheet's normal) is not traced: its trace on the neutral layer is too far from the face's to be one cut."""
@@ -147,13 +155,13 @@ def _runs(walls: list) -> list:
     return runs
 
 
-def _samples(edge, face: SheetFace, reverse: bool) -> tuple:
-    """(k, 3) points and (k, 2) parameters on ``face`` along a cut edge, in the loop's direction."""
+def _at(edge, face: SheetFace, ts: np.ndarray) -> tuple:
+    """(k, 3) points and (k, 2) parameters on ``face`` of a cut edge at its curve's parameters ``ts`` (k,)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Curve2d
 
     curve, c2 = BRepAdaptor_Curve(edge), BRepAdaptor_Curve2d(edge, face.face)
     ps, uvs = [], []
-    for t in edge_parameters(edge, SAMPLE, reverse=reverse):
+    for t in ts:
         p, q = curve.Value(float(t)), c2.Value(float(t))
         ps.append((p.X(), p.Y(), p.Z()))
         uvs.append((q.X(), q.Y()))
@@ -202,39 +210,83 @@ def _square_wall(face: SheetFace, ps: np.ndarray, inward: np.ndarray, thickness:
     return True
 
 
-def _traced(run: list, wall: int, *, chain: tuple, samples: list, inwards: list, topology, faces: tuple,
-            sheet: SheetModel, layer: _Layer, maps: dict, motions: dict) -> list | str:
-    """Per chain edge of ``run`` (consecutive edges along one wall face), the (k, 2) blank positions of its
-    wall's trace on the neutral layer (mm), or all None where the run's trace lies within :data:`SQUARE` of the
-    fixed face's (square to the sheet); a str saying why the run cannot be traced."""
-    ps_run = [samples[k][0] for k in run]
-    rays = _rulings(topology, faces, sheet.skin, wall, [(samples[k][0], inwards[k]) for k in run])
+def _bowed(xy: np.ndarray) -> np.ndarray:
+    """(j,) bool: for ``xy`` (2 j + 1, 2) the ends and middles of ``j`` intervals interleaved, whether each
+    middle lies further than :data:`SAMPLE` from its interval's chord."""
+    a, b, m = xy[0:-1:2], xy[2::2], xy[1::2]
+    ab = b - a
+    length = np.einsum("ij,ij->i", ab, ab)
+    lam = np.clip(np.einsum("ij,ij->i", m - a, ab) / np.where(length > 0, length, 1.0), 0.0, 1.0)
+    return np.linalg.norm(a + lam[:, None] * ab - m, axis=1) > SAMPLE
+
+
+def _lines(edges: list, ts: list, wall: int, *, topology, faces: tuple, sheet: SheetModel,
+           surfaces: dict) -> tuple | str | None:
+    """``(at, inwards, rays)`` of a run's cut edges (``edges``: ``(edge, skin face, reversed)``) at their curves'
+    parameters ``ts``: per edge its (k, 3) points and (k, 2) skin parameters, (k, 3) inward normals and (k, 3)
+    wall lines into the sheet; None where the wall is square to the sheet at every point (it moves less than
+    :data:`SQUARE` across it); a str saying why it cannot be traced."""
+    at = [_at(edge, face, t) for (edge, face, _), t in zip(edges, ts)]
+    inwards = [np.broadcast_to(-normal(face, *uv_mid(face.face)), (len(uvs), 3)) if face.kind == "plane" else
+               -np.array([normal(face, *uv) for uv in uvs]) for (_, face, _), (_, uvs) in zip(edges, at)]
+    rays = _rulings(topology, faces, sheet.skin, wall, [(ps, n) for (ps, _), n in zip(at, inwards)])
     if rays is None:
-        if all(_square_wall(faces[wall], samples[k][0], inwards[k], sheet.thickness, layer.surfaces) for k in run):
-            return [None] * len(run)
+        if all(_square_wall(faces[wall], ps, n, sheet.thickness, surfaces) for (ps, _), n in zip(at, inwards)):
+            return None
         return "its wall has no straight line through the sheet (a spline surface)"
-    if min(float(np.min(np.einsum("ij,ij->i", r, inwards[k]))) for k, r in zip(run, rays)) < STEEP:
+    cos = np.concatenate([np.einsum("ij,ij->i", r, n) for r, n in zip(rays, inwards)])
+    if float(np.min(cos)) < STEEP:
         return "its wall runs nearly along the sheet"
-    traced = []
-    for ps, ds in zip(ps_run, rays):
-        edge = []
-        for p, d in zip(ps, ds):
-            found = layer.neutral(p, d, sheet.thickness / STEEP)
-            if found is None or not _holds(faces[wall], found[0], layer.surfaces):
-                return "its wall changes within the sheet (a counterbore or a countersink: a step before the neutral layer)"
-            edge.append(layer.developed(*found, maps=maps, motions=motions))
-        traced.append(np.array(edge))
-    skin = np.vstack([flat(maps, motions, chain[k][1], samples[k][1]) for k in run])
+    if float(np.max(sheet.thickness * np.sqrt(np.clip(1 - cos * cos, 0.0, None)) / cos)) <= SQUARE:
+        return None
+    return at, inwards, rays
+
+
+def _traced(run: list, wall: int, *, chain: tuple, topology, faces: tuple, sheet: SheetModel, layer: _Layer,
+            maps: dict, motions: dict, deflection: float = SAMPLE, rounds: int = ROUNDS) -> tuple:
+    """``(pieces, reached)`` for a run of chain edges (consecutive edges along one wall face): ``pieces`` per
+    edge the (k, 2) blank positions of its wall's trace on the neutral layer (mm), or all None where the run is
+    square to the sheet (its trace within :data:`SQUARE` of the fixed face's), or a str saying why it cannot be
+    traced; ``reached`` whether a line of the wall met a bend's neutral cylinder.  Each edge is sampled at
+    ``deflection`` mm chord error on the skin, then halved where the developed trace bows more than
+    :data:`SAMPLE` from its chords, up to ``rounds`` times: a straight edge of a flange whose lines meet a bend
+    develops to a curve."""
+    edges = [(topology.edges[chain[k][0]], faces[chain[k][1]], chain[k][2]) for k in run]
+    ts = [edge_parameters(edge, deflection, reverse=reverse) for edge, _, reverse in edges]
+    for round_ in range(rounds):
+        full = [np.insert(t, np.arange(1, len(t)), (t[:-1] + t[1:]) / 2) for t in ts]  # ends and middles
+        got = _lines(edges, full, wall, topology=topology, faces=faces, sheet=sheet, surfaces=layer.surfaces)
+        if got is None:
+            return [None] * len(run), False
+        if isinstance(got, str):
+            return got, False
+        at, _, rays = got
+        traced, reached = [], False
+        for (ps, _), ds in zip(at, rays):
+            edge = []
+            for p, d in zip(ps, ds):
+                found = layer.neutral(p, d, sheet.thickness / STEEP)
+                if found is None or not _holds(faces[wall], found[0], layer.surfaces):
+                    return ("its wall changes within the sheet (a counterbore or a countersink: a step before the "
+                            "neutral layer)"), False
+                reached |= found[1] in layer.bend_faces
+                edge.append(layer.developed(*found, maps=maps, motions=motions))
+            traced.append(np.array(edge))
+        kept = [t[1::2][_bowed(xy)] for t, xy in zip(full, traced)]
+        if round_ == rounds - 1 or not any(len(k) for k in kept):
+            break
+        ts = [np.sort(np.concatenate([t, k]))[::-1 if t[0] > t[-1] else 1] for t, k in zip(ts, kept)]
+    skin = np.vstack([flat(maps, motions, chain[k][1], uvs) for k, (_, uvs) in zip(run, at)])
     drawn = np.vstack(traced)
     off = max(float(np.max(shapely.distance(shapely.points(drawn), shapely.LineString(skin)))),
               float(np.max(shapely.distance(shapely.points(skin), shapely.LineString(drawn)))))
-    return [None] * len(run) if off <= SQUARE else traced
+    return ([None] * len(run) if off <= SQUARE else traced), reached
 
 
 def neutral_trace(chain: tuple, *, topology, faces: tuple, sheet: SheetModel, bends: tuple, maps: dict,
                   motions: dict) -> Oblique | None:
-    """A closed cut contour redrawn on the neutral layer, when it crosses a bend and its wall is not square
-    to the sheet.
+    """A closed cut contour redrawn on the neutral layer, when its wall is not square to the sheet and crosses a
+    bend.
 
     Parameters
     ----------
@@ -254,12 +306,21 @@ def neutral_trace(chain: tuple, *, topology, faces: tuple, sheet: SheetModel, be
     -------
     Oblique or None
         The cut redrawn (the loop's direction kept, one piece per edge of ``chain``), or why it could not be;
-        None where the cut is drawn as it is: it crosses no cylindrical bend, or every edge is square to the
-        sheet (:data:`SQUARE`).
+        None where the cut is drawn as it is: every edge is square to the sheet (:data:`SQUARE`), or it lies on
+        flanges only and its wall's lines meet no bend's neutral layer (or cannot be followed), or no
+        cylindrical bend is next to it.
     """
     touched = {i for _, i, _ in chain}
-    groups = [k for k, g in enumerate(bends) if g.kind == "cylinder" and touched & set(g.faces)]
-    if not groups or any(faces[i].kind not in ("plane", "cylinder") for i in touched):
+    if any(faces[i].kind not in ("plane", "cylinder") for i in touched):
+        return None
+    bend_of = {j: k for k, g in enumerate(bends) if g.kind == "cylinder" for j in g.faces}
+    crossing = any(i in bend_of for i in touched)  # else a cut on flanges, whose wall may reach a bend
+    near = touched | {b for i in touched for b, _ in sheet.neighbours[i]}
+    groups = {bend_of[j] for j in near if j in bend_of}
+    # every flange of those bends bounded by all its bends: a line may leave the layer past one of them
+    flanges = {b for k in groups for j in bends[k].faces for b, _ in sheet.neighbours[j] if faces[b].kind == "plane"}
+    groups |= {bend_of[j] for b in flanges for j, _ in sheet.neighbours[b] if j in bend_of}
+    if not groups:
         return None
     walls = []
     for e, _, _ in chain:
@@ -267,16 +328,24 @@ def neutral_trace(chain: tuple, *, topology, faces: tuple, sheet: SheetModel, be
         if len(rims) != 1:
             return None
         walls.append(rims[0])
-    samples = [_samples(topology.edges[e], faces[i], reverse) for e, i, reverse in chain]
-    inwards = [-np.array([normal(faces[i], *uv) for uv in uvs]) for (_, i, _), (_, uvs) in zip(chain, samples)]
-    layer = _Layer.of(groups, faces=faces, sheet=sheet, bends=bends)
+    runs = _runs(walls)
+    surfaces: dict = {}
+    if all(_lines([(topology.edges[chain[k][0]], faces[chain[k][1]], chain[k][2]) for k in run],
+                  [edge_parameters(topology.edges[chain[k][0]], LOOK, reverse=chain[k][2]) for k in run], walls[run[0]],
+                  topology=topology, faces=faces, sheet=sheet, surfaces=surfaces) is None for run in runs):
+        return None  # square to the sheet everywhere (a first look at a coarse sampling): drawn as it is
+    layer = _Layer.of(sorted(groups), faces=faces, sheet=sheet, bends=bends, surfaces=surfaces)
+    common = dict(chain=chain, topology=topology, faces=faces, sheet=sheet, layer=layer, maps=maps, motions=motions)
+    if not crossing:  # on flanges only: redrawn where its wall is tilted and reaches a bend (a coarse look first)
+        looks = [_traced(run, walls[run[0]], **common, deflection=LOOK, rounds=1) for run in runs]
+        if not any(reached for got, reached in looks if not isinstance(got, str)) or \
+                any(isinstance(got, str) for got, _ in looks):
+            return None
     pieces: list = [None] * len(chain)  # (piece, square) per chain edge
-    for run in _runs(walls):
-        wall = walls[run[0]]
-        got = _traced(run, wall, chain=chain, samples=samples, inwards=inwards, topology=topology, faces=faces,
-                      sheet=sheet, layer=layer, maps=maps, motions=motions)
+    for run in runs:
+        got, _ = _traced(run, walls[run[0]], **common)
         if isinstance(got, str):
-            return Oblique(None, (), got)
+            return None if not crossing else Oblique(None, (), got)
         for k, traced in zip(run, got):
             e, i, reverse = chain[k]
             pieces[k] = (edge_piece(topology.edges[e], i, maps, motions, reverse), True) if traced is None else \
@@ -295,17 +364,18 @@ def neutral_trace(chain: tuple, *, topology, faces: tuple, sheet: SheetModel, be
 
 @dataclass(frozen=True)
 class _Layer:
-    """The neutral layer of the bends a cut crosses and of their flanges."""
+    """The neutral layer of the bends next to a cut (and those of their flanges' other bends) and of their
+    flanges, each flange's bounded by all its bends."""
 
     faces: tuple
     bends: tuple
     groups: tuple
-    junctions: tuple
+    junctions: dict  # {flange: its junctions}
     spans: dict
     surfaces: dict = field(default_factory=dict, compare=False)  # each face's projector, made once (_uv)
 
     @classmethod
-    def of(cls, groups: list, *, faces: tuple, sheet: SheetModel, bends: tuple) -> _Layer:
+    def of(cls, groups: list, *, faces: tuple, sheet: SheetModel, bends: tuple, surfaces: dict) -> _Layer:
         from OCP.BRepTools import BRepTools
 
         junctions, spans = [], {}
@@ -324,8 +394,19 @@ class _Layer:
                         side /= np.linalg.norm(side)
                         side = side if (m - axis_point) @ side > 0 else -side
                         depth = abs(f.radius - bends[k].neutral_radius)  # the bend's neutral layer under this skin
-                        junctions.append(_Junction(k, b, axis_point, side, m, n, depth))
-        return cls(faces, bends, tuple(groups), tuple(junctions), spans)
+                        if not any(x.flange == b and float(x.side @ side) > 1 - 1e-9 and abs(float(
+                                (axis_point - x.axis_point) @ side)) < 1e-6 and abs(x.depth - depth) < 1e-9
+                                   for x in junctions):  # one bend cut in two by a hole: one junction
+                            junctions.append(_Junction(k, b, axis_point, side, m, n, depth))
+        by_flange: dict = {}
+        for x in junctions:
+            by_flange.setdefault(x.flange, []).append(x)
+        return cls(faces, bends, tuple(groups), {b: tuple(xs) for b, xs in sorted(by_flange.items())}, spans, surfaces)
+
+    @property
+    def bend_faces(self) -> frozenset:
+        """The faces of the layer's bends."""
+        return frozenset(j for k in self.groups for j in self.bends[k].faces)
 
     def _on_bend(self, k: int, p: np.ndarray, d: np.ndarray) -> list:
         """``[(s, q, face), ...]``: where the line ``p + s d`` (s > 0) meets bend ``k``'s neutral cylinder
@@ -354,15 +435,15 @@ class _Layer:
         side of each of its junctions.  Under a flange between two bends whose neutral layers lie at different
         depths under its skin (a jog's web at K other than 0.5), the depth goes from one to the other evenly
         across the flange: the layer is continuous with both bends'."""
-        xs = [x for x in self.junctions if x.flange == b]
+        xs = self.junctions[b]
         x = xs[0]
         slope = np.zeros(3)
-        if len(xs) == 2 and abs(xs[1].depth - x.depth) > 1e-12:
+        if len(xs) == 2 and float(xs[0].side @ xs[1].side) < -0.999 and abs(xs[1].depth - x.depth) > 1e-12:
             width = float((xs[1].axis_point - x.axis_point) @ x.side)
             if width > 1e-9:
                 slope = (xs[1].depth - x.depth) / width * x.side  # depth(q) = x.depth + slope @ (q - x.axis_point)
-        elif len(xs) > 2:
-            x = min(xs, key=lambda y: float(np.linalg.norm(p - y.axis_point)))  # the nearest bend's depth
+        elif len({round(y.depth, 12) for y in xs}) > 1:  # bends of other depths round it: the nearest bend's
+            x = min(xs, key=lambda y: (abs(float((p - y.axis_point) @ y.side)), y.bend))
         m = x.normal + slope
         across = -(d @ m)
         if across <= 1e-12:
@@ -377,7 +458,7 @@ class _Layer:
         """``(q, face)``: the first point of the neutral layer on the line from ``p`` (on the skin) along ``d``
         (into the sheet), not further than ``reach`` mm, and the skin face it develops with; None if none."""
         found = [hit for k in self.groups for hit in self._on_bend(k, p, d)]
-        found += [hit for b in sorted({x.flange for x in self.junctions}) for hit in self._on_flange(b, p, d)]
+        found += [hit for b in self.junctions for hit in self._on_flange(b, p, d)]
         found = [hit for hit in found if hit[0] <= reach]
         if not found:
             return None
