@@ -23,7 +23,7 @@ def crown_of(uv: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """(2,) float64: where darts meet on a flat layout ``uv`` ``(n, 2)`` mm, the centroid of the
     vertices weighted by their positive angle defects ``weights`` ``(n,)`` (their mean without any)."""
     total = float(np.sum(weights))
-    return weights @ uv / total if total > 0 else uv.mean(axis=0)
+    return np.einsum("i,ij->j", weights, uv) / total if total > 0 else uv.mean(axis=0)  # no BLAS: its bits
 
 
 def gore_bound(result: Flattening, limit: float, *, defects=None, crown=None) -> float:

@@ -59,8 +59,14 @@ def neutral_offset(thickness: float, k_factor: float, reference: str, *, name: s
 def _radial(surface, points):
     """Axial height, radial distance and angle of points about the surface's axis."""
     rel = points - surface.origin
-    x, y = rel @ surface.x_dir, rel @ surface.y_dir
-    return rel @ surface.axis, np.hypot(x, y), np.arctan2(y, x)
+    x, y = _along(rel, surface.x_dir), _along(rel, surface.y_dir)
+    return _along(rel, surface.axis), np.hypot(x, y), np.arctan2(y, x)
+
+
+def _along(rel: np.ndarray, direction) -> np.ndarray:
+    """(n,) each row of ``rel`` (n, 3) dotted with ``direction`` (3,): ``einsum``, not a BLAS product, whose
+    rounding follows the CPU's kernels (fused multiply-adds on one, not on another)."""
+    return np.einsum("ij,j->i", rel, np.asarray(direction, dtype=np.float64))
 
 
 def offset_points(surface, points: np.ndarray, offset: float) -> np.ndarray:
@@ -68,7 +74,7 @@ def offset_points(surface, points: np.ndarray, offset: float) -> np.ndarray:
     if offset == 0.0 or surface.kind is SurfaceKind.PLANE:
         return np.array(points, dtype=np.float64)
     rel = points - surface.origin
-    h = rel @ surface.axis
+    h = _along(rel, surface.axis)
     radial = rel - np.outer(h, surface.axis)
     r = np.linalg.norm(radial, axis=1, keepdims=True)
     out_dir = radial / np.maximum(r, 1e-300)
@@ -108,7 +114,7 @@ def develop(surface, points: np.ndarray, param: np.ndarray | None = None, *, off
         return _develop_general_cone(surface, points)
     if surface.kind is SurfaceKind.PLANE:
         rel = points - surface.origin
-        return np.column_stack([rel @ surface.x_dir, rel @ surface.y_dir])
+        return np.column_stack([_along(rel, surface.x_dir), _along(rel, surface.y_dir)])
     h, r, angle = _radial(surface, points)
     if param is not None:
         # The same 3D point on both sides of a seam: atan2 cannot tell; the
@@ -145,7 +151,7 @@ def _develop_general_cone(surface, points: np.ndarray) -> np.ndarray:
     # Nearest sample of the directrix's direction, then the segment beside it that the
     # direction lies nearest; on it, the angle turned from the segment's start (exact where the
     # cone is flat between two rulings: the direction then lies on their great circle).
-    k = np.argmax(u @ table.T, axis=1)
+    k = np.argmax(np.einsum("ij,kj->ik", u, table), axis=1)
     k = np.clip(k, 1, len(table) - 2)
     for shift in (-1, 0):
         a, b = table[k + shift], table[k + shift + 1]

@@ -41,5 +41,6 @@ def turn_to_grain(result: Flattening, direction) -> Flattening:
     angle = np.pi / 2 - np.arctan2(d[1], d[0])
     c, s = np.cos(angle), np.sin(angle)
     centre = result.uv.mean(axis=0)
-    uv = (result.uv - centre) @ np.array([[c, s], [-s, c]]) + centre
+    x, y = result.uv[:, 0] - centre[0], result.uv[:, 1] - centre[1]  # written out: a BLAS product's bits vary by CPU
+    uv = np.column_stack([x * c - y * s + centre[0], x * s + y * c + centre[1]])
     return replace(result, uv=_readonly(uv))

@@ -12,7 +12,7 @@ sheet (a drilled cylinder's axis, a cone's generator; on a plane, the
 direction of its own edges across the sheet at the two ends, turned from one
 to the other along the cut), to the first point of the neutral layer (the
 neutral cylinder within each bend's angle, the plane as deep as that bend's
-neutral layer under each flange, ending at the flange's bends), which it
+neutral layer under each flange, ending at its bends and its free end), which it
 develops as the bend and flanges are; between samples the developed trace is
 refined until it bows no more than :data:`SAMPLE`.  A cut edge whose trace lies
 within :data:`SQUARE` of the fixed face's on the blank is square to the sheet
@@ -210,6 +210,22 @@ def _square_wall(face: SheetFace, ps: np.ndarray, inward: np.ndarray, thickness:
     return True
 
 
+def _reach(topology, b: int, xs: tuple) -> tuple:
+    """How far flange ``b`` reaches from each of its junctions ``xs``, along the junction's ``side`` (mm): the
+    furthest of its edges, sampled at 1e-5 mm chord error (its free end, or its next bend)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+
+    points = []
+    for walk in topology.wires[b]:
+        for _, edge in walk:
+            curve = BRepAdaptor_Curve(edge)
+            for t in edge_parameters(edge, 1e-5, reverse=False):
+                p = curve.Value(float(t))
+                points.append((p.X(), p.Y(), p.Z()))
+    points = np.array(points)
+    return tuple(float(np.max((points - x.axis_point) @ x.side)) for x in xs)
+
+
 def _bowed(xy: np.ndarray) -> np.ndarray:
     """(j,) bool: for ``xy`` (2 j + 1, 2) the ends and middles of ``j`` intervals interleaved, whether each
     middle lies further than :data:`SAMPLE` from its interval's chord."""
@@ -334,7 +350,7 @@ def neutral_trace(chain: tuple, *, topology, faces: tuple, sheet: SheetModel, be
                   [edge_parameters(topology.edges[chain[k][0]], LOOK, reverse=chain[k][2]) for k in run], walls[run[0]],
                   topology=topology, faces=faces, sheet=sheet, surfaces=surfaces) is None for run in runs):
         return None  # square to the sheet everywhere (a first look at a coarse sampling): drawn as it is
-    layer = _Layer.of(sorted(groups), faces=faces, sheet=sheet, bends=bends, surfaces=surfaces)
+    layer = _Layer.of(sorted(groups), topology=topology, faces=faces, sheet=sheet, bends=bends, surfaces=surfaces)
     common = dict(chain=chain, topology=topology, faces=faces, sheet=sheet, layer=layer, maps=maps, motions=motions)
     if not crossing:  # on flanges only: redrawn where its wall is tilted and reaches a bend (a coarse look first)
         looks = [_traced(run, walls[run[0]], **common, deflection=LOOK, rounds=1) for run in runs]
@@ -372,10 +388,11 @@ class _Layer:
     groups: tuple
     junctions: dict  # {flange: its junctions}
     spans: dict
+    reaches: dict  # {flange: how far it reaches from each of its junctions (_reach), mm}
     surfaces: dict = field(default_factory=dict, compare=False)  # each face's projector, made once (_uv)
 
     @classmethod
-    def of(cls, groups: list, *, faces: tuple, sheet: SheetModel, bends: tuple, surfaces: dict) -> _Layer:
+    def of(cls, groups: list, *, topology, faces: tuple, sheet: SheetModel, bends: tuple, surfaces: dict) -> _Layer:
         from OCP.BRepTools import BRepTools
 
         junctions, spans = [], {}
@@ -401,7 +418,9 @@ class _Layer:
         by_flange: dict = {}
         for x in junctions:
             by_flange.setdefault(x.flange, []).append(x)
-        return cls(faces, bends, tuple(groups), {b: tuple(xs) for b, xs in sorted(by_flange.items())}, spans, surfaces)
+        by_flange = {b: tuple(xs) for b, xs in sorted(by_flange.items())}
+        reaches = {b: _reach(topology, b, xs) for b, xs in by_flange.items()}
+        return cls(faces, bends, tuple(groups), by_flange, spans, reaches, surfaces)
 
     @property
     def bend_faces(self) -> frozenset:
@@ -452,6 +471,8 @@ class _Layer:
         q = p + s * d
         if s <= -1e-9 or not all(y.on_flange(q) for y in xs):
             return []
+        if any(float((q - y.axis_point) @ y.side) > reach + 1e-6 for y, reach in zip(xs, self.reaches[b])):
+            return []  # past the flange's free end: under no skin of it
         return [(float(s), q, b)]
 
     def neutral(self, p: np.ndarray, d: np.ndarray, reach: float) -> tuple | None:
