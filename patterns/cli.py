@@ -587,8 +587,9 @@ def main(argv=None) -> int:
     debug = "--debug" in argv
     argv = [a for a in argv if a != "--debug"]  # anywhere on the line
     saved = sys.stdout, sys.stderr
-    restore = signals.install()  # first: a signal during the heavy imports ends the run in one line too
+    restore = None
     try:  # from here on a signal, wherever it lands, is the stop it was (_ended)
+        restore = signals.install()  # first, inside: a restore that cannot be skipped (its run would never end)
         foreign_home()
         sys.stdout, sys.stderr = Terminal(sys.stdout), Terminal(sys.stderr)
         if argv == ["serve"]:  # the engine for a CAD program (docs/worker.md): its standard output is the protocol's
@@ -603,7 +604,8 @@ def main(argv=None) -> int:
     except BaseException as exc:  # noqa: BLE001 - each kind is sorted out (and the rest raised) by _ended
         return _ended(exc, debug)
     finally:
-        restore()
+        if restore is not None:
+            restore()
         sys.stdout.flush()
         sys.stderr.flush()
         sys.stdout, sys.stderr = saved

@@ -17,8 +17,9 @@ __all__ = ["main"]
 
 def main() -> int:
     """Run the command line (:func:`patterns.cli.main`) with the stop handlers in place from the start."""
-    restore = signals.install()  # cli.main installs them again for its own run, and puts these back after it
+    restore = None
     try:
+        restore = signals.install()  # cli.main installs them again, nested: one run; these come back after both
         try:
             from .cli import main as run
         except BaseException:
@@ -29,4 +30,5 @@ def main() -> int:
             return signals.exit_code(stop)
         return run()
     finally:
-        restore()
+        if restore is not None:
+            restore()

@@ -32,8 +32,14 @@ _COMMITTED: list = []
 """The outputs renamed onto their targets since :func:`install` (:func:`committed`)."""
 
 _DEPTH: list = []
-"""One entry per :func:`install` not yet restored: a run's own install inside another's (the launcher's, then
-the command line's) is the same run, and keeps what was received before it."""
+"""The unraisable hooks of the installs not yet restored, outermost first: a run's own install inside another
+(the launcher's, then the command line's) is the same run, and keeps what was received before it."""
+
+_UNDER: dict = {}
+"""Each of those hooks (and of the run's restored ones) -> the hook it passes other errors to."""
+
+_PREVIOUS: dict = {}
+"""The handlers there were before the run's outermost install, put back when its last install is restored."""
 
 
 def _handler(signum, frame):
@@ -47,11 +53,13 @@ def install():
     """Handle SIGINT and SIGTERM as above (one ignored stays ignored); returns a function that puts back the
     handlers there were.  A new run forgets the stops of earlier ones; an install inside another (the launcher's,
     then :func:`patterns.cli.main`'s) is the same run and keeps a stop received between the two, such as one
-    quieted during the heavy imports.  Outside the main thread (a test harness, a host's worker thread) nothing
-    is installed and the function does nothing."""
+    quieted during the heavy imports; the handlers and the unraisable hook there were come back when the last
+    install is restored, in whatever order they are.  Outside the main thread (a test harness, a host's worker
+    thread) nothing is installed and the function does nothing."""
     if not _DEPTH:
         _RECEIVED.clear()
         _COMMITTED.clear()
+        _UNDER.clear()
     try:
         # a signal the process was started ignoring stays ignored (nohup, a shell's background job: as Python
         # itself leaves SIGINT then)
@@ -59,6 +67,9 @@ def install():
                     if signal.getsignal(s) is not signal.SIG_IGN}
     except ValueError:  # not the main thread
         return lambda: None
+    if not _DEPTH:
+        _PREVIOUS.clear()
+        _PREVIOUS.update(previous)
     hook = sys.unraisablehook
 
     def quiet(unraisable):
@@ -66,19 +77,21 @@ def install():
         if not (_RECEIVED and isinstance(unraisable.exc_value, (KeyboardInterrupt, Terminated))):
             hook(unraisable)
 
-    sys.unraisablehook = quiet
-    _DEPTH.append(quiet)
-
     def restore():
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-        if sys.unraisablehook is quiet:  # a hook someone set after ours stays theirs
-            sys.unraisablehook = hook
         if quiet in _DEPTH:
             _DEPTH.remove(quiet)
+        current = sys.unraisablehook
+        while current in _UNDER and current not in _DEPTH:  # ours, of an install restored: the one under it
+            current = _UNDER[current]
+        sys.unraisablehook = current  # a hook someone set after ours stays theirs
         if not _DEPTH:
+            for s, handler in _PREVIOUS.items():
+                signal.signal(s, handler)
             _RECEIVED.clear()  # the run is over: a library call after it is not stopped by it
 
+    _UNDER[quiet] = hook
+    sys.unraisablehook = quiet
+    _DEPTH.append(quiet)
     return restore
 
 

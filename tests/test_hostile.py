@@ -314,6 +314,41 @@ thing = Thing(); ref = weakref.ref(thing, stop); del thing
     assert "ValueError: another error" in run.stderr and word in run.stderr.splitlines()[-1], run.stderr
 
 
+def test_installs_restored_in_any_order_leave_the_handlers_and_hook_there_were():
+    """The launcher's install and the command line's, nested, restored in either order: the signal handlers and
+    the unraisable hook there were before both come back (restoring the outer one first used to leave the
+    inner's hook in place for good); a hook someone set after ours stays theirs; a stop received inside is kept
+    until the last restore, then forgotten."""
+    import signal
+    import sys
+
+    from patterns import signals
+
+    kinds = (signal.SIGINT, signal.SIGTERM)
+    hook, handlers = sys.unraisablehook, [signal.getsignal(s) for s in kinds]
+    for order in ("outer first", "inner first"):
+        outer = signals.install()
+        signals._RECEIVED.append(signal.SIGTERM)  # as the handler notes a stop
+        inner = signals.install()
+        assert signals.received() == signal.SIGTERM  # one run: kept
+        first, second = (outer, inner) if order == "outer first" else (inner, outer)
+        first()
+        assert signals.received() == signal.SIGTERM and signal.getsignal(signal.SIGTERM) is signals._handler
+        second()
+        assert signals.received() is None, order
+        assert sys.unraisablehook is hook and [signal.getsignal(s) for s in kinds] == handlers, order
+
+    def theirs(unraisable):
+        pass
+
+    outer, inner = signals.install(), signals.install()
+    sys.unraisablehook = theirs
+    inner()
+    outer()
+    assert sys.unraisablehook is theirs
+    sys.unraisablehook = hook
+
+
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
 def test_a_stop_quieted_during_the_heavy_imports_is_not_forgotten_by_the_run(tmp_path, sig):
     """The ``patterns`` command installs the handlers (patterns.launch), imports the command line, whose main()

@@ -540,6 +540,28 @@ def test_a_window_under_a_teardrop_hem_is_not_traced_onto_its_return_flange_run_
         assert [f"neutral layer, {neutral:.2f} mm²" in m for m in notes] == ([True] if z == 0.0 else [])
 
 
+@pytest.mark.parametrize("k", [0.4, 0.5])
+def test_a_cut_through_the_gap_of_an_s_jogs_neutral_layer_says_so(k):
+    """The S jog's two bends touch with no flat between: at K 0.4 their neutral layers lie at different depths
+    (0.6 and 0.9 mm under the top skin) and leave a gap at the tangent line, so a Ø 3 drilled at 135° through
+    it has lines that meet no neutral layer: the note says that (not "a counterbore", as it did), and the hole
+    is the fixed face's trace.  At K 0.5 the layer is continuous and the hole is traced (the closed form, 1e-5)."""
+    seg, t, w = PROFILES["s_jog"]
+    origin, rot = (33.0, 20.0, 2.0), bd.Rot(0, 135, 0)
+    part = _drilled(seg, t=t, width=w, tool=bd.Cylinder(1.5, 40, align=(bd.Align.CENTER,) * 3), origin=origin,
+                    rot=rot)
+    for z in (0.0, -t):
+        blank = patterns.unfold(part, k_factor=k, name="cut", fixed_face=_flat_faces(part, z))
+        (note,) = [f.message for f in blank.findings if f.code is patterns.Code.OBLIQUE_CUT]
+        (hole,) = blank.holes
+        if k == 0.5:
+            neutral = _cut_trace(seg, t=t, k=k, outline=_circle(3.0), origin=origin, rot=rot)
+            assert hole.area == pytest.approx(neutral, rel=1e-5) and f"neutral layer, {neutral:.2f} mm²" in note
+        else:
+            assert "meets no neutral layer" in note and "counterbore" not in note
+            assert f"drawn as the fixed face's trace, {hole.area:.2f} mm²" in note
+
+
 def _outside_trace(*, xc: float, rad: float, floor: float, k: float, n: int = 200000) -> float:
     """The developed area of the L's outside skin inside the vertical cylinder of radius ``rad`` about
     ``x = xc`` and below the plane ``z = floor``: flange A's bottom (x <= LA, a circle's segment) and the bend's

@@ -282,7 +282,10 @@ def _traced(run: list, wall: int, *, chain: tuple, topology, faces: tuple, sheet
             edge = []
             for p, d in zip(ps, ds):
                 found = layer.neutral(p, d, sheet.thickness / STEEP)
-                if found is None or not _holds(faces[wall], found[0], layer.surfaces):
+                if found is None:
+                    return ("its wall's line meets no neutral layer (two bends with no flat between them, whose "
+                            "neutral layers lie at different depths, leave a gap)"), False
+                if not _holds(faces[wall], found[0], layer.surfaces):
                     return ("its wall changes within the sheet (a counterbore or a countersink: a step before the "
                             "neutral layer)"), False
                 reached |= found[1] in layer.bend_faces
