@@ -110,11 +110,14 @@ def _across(topology, wall: int, skin: frozenset, at: np.ndarray, inward: np.nda
     return None
 
 
-def _rulings(topology, faces: tuple, skin: frozenset, wall: int, run: list) -> list | None:
+def _rulings(topology, faces: tuple, skin: frozenset, wall: int, run: list, along: list | None = None,
+             ends: list | None = None) -> list | None:
     """The wall's straight lines through the sheet at the points of a run of cut edges along it: per edge of
     ``run`` (``[((k, 3) points, (k, 3) inward normals), ...]``, in the loop's order), (k, 3) unit directions
     into the sheet; None for a wall with none (a spline surface).  A plane's lines turn from its edge across
-    the sheet at the run's start to the one at its end, evenly along the run."""
+    the sheet at the run's start to the one at its end (``ends``, two (3,), where given: :func:`_ends`), evenly
+    along the run: by ``along`` (per edge (k,), the share of the run's length before each point) where given,
+    else by the points' own polyline."""
     f = faces[wall]
     ps, inward = np.vstack([p for p, _ in run]), np.vstack([n for _, n in run])
     if f.kind == "cylinder":
@@ -124,11 +127,12 @@ def _rulings(topology, faces: tuple, skin: frozenset, wall: int, run: list) -> l
         rays = ps - np.array([a.X(), a.Y(), a.Z()])
     elif f.kind == "plane":
         n = normal(f, *uv_mid(f.face))
-        ends = [_across(topology, wall, skin, ps[j], inward[j]) for j in (0, -1)]
-        # no edge across the sheet at an end (a closed edge): the plane's line nearest the sheet's normal there
-        ends = [v if v is not None else inward[j] - (inward[j] @ n) * n for v, j in zip(ends, (0, -1))]
-        along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ps, axis=0), axis=1))])
-        lam = (along / along[-1] if along[-1] > 0 else np.zeros(len(ps)))[:, None]
+        ends = ends if ends is not None else _ends(topology, f, skin, wall, ps, inward)
+        if along is not None:
+            lam = np.concatenate(along)[:, None]
+        else:
+            along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ps, axis=0), axis=1))])
+            lam = (along / along[-1] if along[-1] > 0 else np.zeros(len(ps)))[:, None]
         rays = (1 - lam) * ends[0] + lam * ends[1]
         rays -= (rays @ n)[:, None] * n  # in the plane
     else:
@@ -139,6 +143,15 @@ def _rulings(topology, faces: tuple, skin: frozenset, wall: int, run: list) -> l
         return None
     rays /= length[:, None]
     return np.split(rays, np.cumsum([len(p) for p, _ in run])[:-1])
+
+
+def _ends(topology, f: SheetFace, skin: frozenset, wall: int, ps: np.ndarray, inward: np.ndarray) -> list:
+    """A plane wall's two lines across the sheet at a run's first and last points ``ps[0]``, ``ps[-1]`` (of
+    (k, 3); ``inward`` (k, 3) the skin's inward normals): its own edges there, or where it has none (a closed
+    edge) its line nearest the sheet's normal."""
+    n = normal(f, *uv_mid(f.face))
+    ends = [_across(topology, wall, skin, ps[j], inward[j]) for j in (0, -1)]
+    return [v if v is not None else inward[j] - (inward[j] @ n) * n for v, j in zip(ends, (0, -1))]
 
 
 def _runs(walls: list) -> list:
@@ -165,7 +178,7 @@ def _at(edge, face: SheetFace, ts: np.ndarray) -> tuple:
         p, q = curve.Value(float(t)), c2.Value(float(t))
         ps.append((p.X(), p.Y(), p.Z()))
         uvs.append((q.X(), q.Y()))
-    return np.array(ps), np.array(uvs)
+    return np.array(ps, dtype=np.float64).reshape(-1, 3), np.array(uvs, dtype=np.float64).reshape(-1, 2)
 
 
 def _uv(face: SheetFace, q: np.ndarray, surfaces: dict) -> np.ndarray:
@@ -237,15 +250,15 @@ def _bowed(xy: np.ndarray) -> np.ndarray:
 
 
 def _lines(edges: list, ts: list, wall: int, *, topology, faces: tuple, sheet: SheetModel,
-           surfaces: dict) -> tuple | str | None:
+           surfaces: dict, along: list | None = None, ends: list | None = None) -> tuple | str | None:
     """``(at, inwards, rays)`` of a run's cut edges (``edges``: ``(edge, skin face, reversed)``) at their curves'
     parameters ``ts``: per edge its (k, 3) points and (k, 2) skin parameters, (k, 3) inward normals and (k, 3)
     wall lines into the sheet; None where the wall is square to the sheet at every point (it moves less than
     :data:`SQUARE` across it); a str saying why it cannot be traced."""
     at = [_at(edge, face, t) for (edge, face, _), t in zip(edges, ts)]
     inwards = [np.broadcast_to(-normal(face, *uv_mid(face.face)), (len(uvs), 3)) if face.kind == "plane" else
-               -np.array([normal(face, *uv) for uv in uvs]) for (_, face, _), (_, uvs) in zip(edges, at)]
-    rays = _rulings(topology, faces, sheet.skin, wall, [(ps, n) for (ps, _), n in zip(at, inwards)])
+               -np.array([normal(face, *uv) for uv in uvs]).reshape(-1, 3) for (_, face, _), (_, uvs) in zip(edges, at)]
+    rays = _rulings(topology, faces, sheet.skin, wall, [(ps, n) for (ps, _), n in zip(at, inwards)], along, ends)
     if rays is None:
         if all(_square_wall(faces[wall], ps, n, sheet.thickness, surfaces) for (ps, _), n in zip(at, inwards)):
             return None
@@ -269,18 +282,32 @@ def _traced(run: list, wall: int, *, chain: tuple, topology, faces: tuple, sheet
     develops to a curve."""
     edges = [(topology.edges[chain[k][0]], faces[chain[k][1]], chain[k][2]) for k in run]
     ts = [edge_parameters(edge, deflection, reverse=reverse) for edge, _, reverse in edges]
+    # where each parameter lies along the run (mm, by the first samples' polyline): a plane wall's line at a
+    # point is then the same whichever points are around it, and a point traced once is kept (``done``)
+    first = [_at(edge, face, t) for (edge, face, _), t in zip(edges, ts)]
+    lengths = [np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(ps, axis=0), axis=1))] for ps, _ in first]
+    starts = np.r_[0.0, np.cumsum([x[-1] for x in lengths])]
+    total = starts[-1] if starts[-1] > 0 else 1.0
+    increasing = [(t, x) if t[0] <= t[-1] else (t[::-1], x[::-1]) for t, x in zip(ts, lengths)]
+    ends = None
+    if faces[wall].kind == "plane":
+        (p0, uv0), (p1, uv1) = first[0], first[-1]
+        inward = np.array([-normal(edges[0][1], *uv0[0]), -normal(edges[-1][1], *uv1[-1])])
+        ends = _ends(topology, faces[wall], sheet.skin, wall, np.array([p0[0], p1[-1]]), inward)
+    done: list = [{} for _ in run]  # per edge: parameter -> (developed (2,), reached)
     for round_ in range(rounds):
         full = [np.insert(t, np.arange(1, len(t)), (t[:-1] + t[1:]) / 2) for t in ts]  # ends and middles
-        got = _lines(edges, full, wall, topology=topology, faces=faces, sheet=sheet, surfaces=layer.surfaces)
+        new = [np.array([t for t in f if float(t) not in d]) for f, d in zip(full, done)]
+        along = [(starts[j] + np.interp(t, *increasing[j])) / total for j, t in enumerate(new)]
+        got = _lines(edges, new, wall, topology=topology, faces=faces, sheet=sheet, surfaces=layer.surfaces,
+                     along=along, ends=ends)
         if got is None:
             return [None] * len(run), False
         if isinstance(got, str):
             return got, False
         at, _, rays = got
-        traced, reached = [], False
-        for (ps, _), ds in zip(at, rays):
-            edge = []
-            for p, d in zip(ps, ds):
+        for j, ((ps, _), ds) in enumerate(zip(at, rays)):
+            for t, p, d in zip(new[j], ps, ds):
                 found = layer.neutral(p, d, sheet.thickness / STEEP)
                 if found is None:
                     return ("its wall's line meets no neutral layer (two bends with no flat between them, whose "
@@ -288,13 +315,14 @@ def _traced(run: list, wall: int, *, chain: tuple, topology, faces: tuple, sheet
                 if not _holds(faces[wall], found[0], layer.surfaces):
                     return ("its wall changes within the sheet (a counterbore or a countersink: a step before the "
                             "neutral layer)"), False
-                reached |= found[1] in layer.bend_faces
-                edge.append(layer.developed(*found, maps=maps, motions=motions))
-            traced.append(np.array(edge))
+                done[j][float(t)] = (layer.developed(*found, maps=maps, motions=motions), found[1] in layer.bend_faces)
+        traced = [np.array([done[j][float(t)][0] for t in f]) for j, f in enumerate(full)]
+        reached = any(done[j][float(t)][1] for j, f in enumerate(full) for t in f)
         kept = [t[1::2][_bowed(xy)] for t, xy in zip(full, traced)]
         if round_ == rounds - 1 or not any(len(k) for k in kept):
             break
         ts = [np.sort(np.concatenate([t, k]))[::-1 if t[0] > t[-1] else 1] for t, k in zip(ts, kept)]
+    at = [_at(edge, face, t) for (edge, face, _), t in zip(edges, full)]
     skin = np.vstack([flat(maps, motions, chain[k][1], uvs) for k, (_, uvs) in zip(run, at)])
     drawn = np.vstack(traced)
     off = max(float(np.max(shapely.distance(shapely.points(drawn), shapely.LineString(skin)))),
