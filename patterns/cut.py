@@ -467,9 +467,9 @@ def insert_line(vertices: np.ndarray, faces: np.ndarray, uv: np.ndarray, start, 
     flat_len = np.linalg.norm(uv[edges[:, 1]] - uv[edges[:, 0]], axis=1)
     mean_len = np.bincount(edges.ravel(), weights=np.repeat(flat_len, 2), minlength=n) / np.maximum(
         np.bincount(edges.ravel(), minlength=n), 1)
-    length2 = float(d @ d)
+    length2 = float(d[0] * d[0] + d[1] * d[1])  # written out: a BLAS product rounds by the CPU's kernels
     rel = uv - a
-    t_vertex = rel @ d / length2
+    t_vertex = (rel[:, 0] * d[0] + rel[:, 1] * d[1]) / length2
     off = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0]) / np.sqrt(length2)
     on_line = (off < snap * mean_len) & (t_vertex >= 0) & (t_vertex <= 1)
     if keep_off is not None:

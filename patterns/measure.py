@@ -22,6 +22,7 @@ a column, never as the judge (docs/measures.md).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -496,12 +497,12 @@ def flat_direction(vertices, faces, uv, direction) -> np.ndarray:
     f1, f2 = q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]
     # Solve direction ~ a e1 + b e2 (least squares on the triangle's plane): Gram system.
     g11, g12, g22 = (e1 * e1).sum(1), (e1 * e2).sum(1), (e2 * e2).sum(1)
-    r1, r2 = e1 @ direction, e2 @ direction
+    r1, r2 = np.einsum("ij,j->i", e1, direction), np.einsum("ij,j->i", e2, direction)  # no BLAS
     det = g11 * g22 - g12 * g12
     a = (g22 * r1 - g12 * r2) / det
     b = (g11 * r2 - g12 * r1) / det
     images = a[:, None] * f1 + b[:, None] * f2
     area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
     total = (images * area[:, None]).sum(axis=0)
-    norm = np.linalg.norm(total)
+    norm = math.hypot(*total)
     return total / norm if norm > 0 else np.array([0.0, 1.0])

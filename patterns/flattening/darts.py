@@ -56,6 +56,7 @@ Measured: ``benchmarks/darts.py`` and the table in docs/garments.md.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -257,7 +258,7 @@ def _next_steps(plan, step: _Step, tried, max_darts):
             yield more
         return
     at = plan.worst_point(tried)
-    beyond = np.linalg.norm(at - plan.crown) < step.core + plan.gap
+    beyond = math.hypot(*(at - plan.crown)) < step.core + plan.gap  # no BLAS (its rounding follows the CPU)
     if beyond and plan.strained_at_tips(tried, step.core) and step.core > 1.01 * plan.min_core(step.k):
         yield step._replace(core=max(step.core * _LENGTHEN, plan.min_core(step.k)))  # all run on
     if beyond and not step.deep and step.k >= 4:
@@ -486,7 +487,7 @@ def dart_lines(result: Flattening, k: int, limit: float, *, split: bool = False,
             if closed and i in (0, len(run) - 1):
                 before, after = run[-3], run[2]
             tangent = uv[after] - uv[before]
-            inward = np.array([-tangent[1], tangent[0]]) / max(np.linalg.norm(tangent), 1e-300)
+            inward = np.array([-tangent[1], tangent[0]]) / max(math.hypot(*tangent), 1e-300)
             lines.append(DartLine(vertex, inward, _reach(polygon, uv[vertex], inward)))
     return lines
 

@@ -14,6 +14,8 @@ as the 3D boundary; LSCM: two boundary vertices pinned at their 3D distance).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import qdldl
 import scipy.sparse as sp
@@ -273,7 +275,7 @@ def lscm(vertices: np.ndarray, faces: np.ndarray, conn: Connectivity, *, local: 
     p0 = loop[np.argmax(np.linalg.norm(vertices[loop] - vertices[loop[0]], axis=1))]
     p1 = loop[np.argmax(np.linalg.norm(vertices[loop] - vertices[p0], axis=1))]
     fixed = np.array([p0, p1])
-    values = np.array([0.0, np.linalg.norm(vertices[p1] - vertices[p0])], dtype=np.complex128)
+    values = np.array([0.0, math.hypot(*(vertices[p1] - vertices[p0]))], dtype=np.complex128)  # no BLAS
     free = np.ones(n, dtype=bool)
     free[fixed] = False
     a_free, a_fixed = system[:, free], system[:, fixed]

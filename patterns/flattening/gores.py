@@ -115,7 +115,11 @@ def gore_paths(result: Flattening, k: int, limit: float):
     normals = np.array([line.direction for line in lines])
     # The crown: the point nearest all the lines (least squares), at a vertex of the panel.
     projector = np.eye(2)[None] - normals[:, :, None] * normals[:, None, :]
-    crown_point = np.linalg.lstsq(projector.sum(axis=0), np.einsum("kij,kj->i", projector, starts), rcond=None)[0]
+    (a, b), (c, d) = projector.sum(axis=0)
+    rhs = np.einsum("kij,kj->i", projector, starts)
+    det = a * d - b * c  # the 2 x 2 normal equations solved in closed form: LAPACK's rounding follows the CPU
+    crown_point = np.array([d * rhs[0] - b * rhs[1], a * rhs[1] - c * rhs[0]]) / det if abs(det) > 1e-12 * (
+        a * d + b * b + c * c) else np.linalg.lstsq(projector.sum(axis=0), rhs, rcond=None)[0]
     loops = [np.asarray(loop) for loop in result.loops]
     polygon = shapely.Polygon(uv[loops[0]], [uv[loop] for loop in loops[1:]])
     if not shapely.contains_xy(polygon, *crown_point):

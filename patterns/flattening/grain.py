@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import replace
 
@@ -29,9 +30,9 @@ def grain_table(grain, model) -> dict:
             d = np.asarray(direction, dtype=np.float64).reshape(3)
         except (TypeError, ValueError):
             raise InputError(f"{model.name}: a grain is a 3D direction (x, y, z), got {direction!r}") from None
-        if not np.all(np.isfinite(d)) or np.linalg.norm(d) == 0:
+        if not np.all(np.isfinite(d)) or not np.any(d):
             raise InputError(f"{model.name}: a grain is a non-zero 3D direction, got {direction!r}")
-        out[name] = d / np.linalg.norm(d)
+        out[name] = d / math.hypot(*d)  # no BLAS: the same bits on every CPU
     return out
 
 

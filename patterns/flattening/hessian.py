@@ -86,7 +86,7 @@ def projected_hessian(fr: Frames, jac: Jacobian, stretch: tuple[float, float], *
     g[:, 2, :3], g[:, 2, 3:] = root[2][:, None] * (a0 - b0), root[2][:, None] * (a1 - b1)
     g[:, 3, :3], g[:, 3, 3:] = root[3][:, None] * (a0 + b0), root[3][:, None] * (a1 + b1)
     if not packed:
-        return np.matmul(g.transpose(0, 2, 1), g)
+        return np.einsum("mki,mkj->mij", g, g)  # einsum, not BLAS: the same bits on every CPU
     by_entry = np.ascontiguousarray(g.transpose(2, 1, 0))  # (6, 4, m): 21 products of rows, not a 6 x 6 matmul
     out = np.empty((len(w), len(PAIRS)))
     for k, (a, b) in enumerate(PAIRS):

@@ -36,6 +36,7 @@ piece 2.06 %, each insert 0.2 % (docs/garments.md).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 
 import numpy as np
@@ -172,7 +173,7 @@ class _Outline:
             at = (first + j * total / k) % total
             start = uv[outer[int(np.argmin(np.abs(arc[:-1] - at)))]]
             tip = int(np.argmin(np.linalg.norm(p - (start + depth * (trough - start)), axis=1)))
-            half = float(np.linalg.norm(p[tip] - start)) * np.tan(angle / 2.0)
+            half = math.hypot(*(p[tip] - start)) * np.tan(angle / 2.0)  # no BLAS: its rounding follows the CPU
             if half >= total / (2 * k):
                 return None  # the wedges would meet on the outline
             for side in (-1.0, 1.0):

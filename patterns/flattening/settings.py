@@ -7,6 +7,7 @@ declarations (:meth:`FlattenOptions.checked`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -72,7 +73,7 @@ def _direction(value, option):
     if not np.all(np.isfinite(d)) or not np.any(d):
         raise InputError(f"{option} must be a non-zero 3D direction, got {value!r}")
     d = d / np.abs(d).max()  # a direction: its length does not matter (1e308, 1e308, 0 is (1, 1, 0))
-    return tuple(float(x) for x in d / np.linalg.norm(d))
+    return tuple(float(x) for x in d / math.hypot(*d))  # no BLAS: the same bits on every CPU
 
 
 def _ease(value, option):
