@@ -269,6 +269,20 @@ def test_a_stop_a_library_swallowed_still_writes_nothing(tmp_path):
     assert signals.received() is None  # a run over: later library calls are not stopped by it
 
 
+_STOP_IN_A_CALLBACK = """
+import os, signal, sys, weakref
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as a user's shell gives it (.ci/run & ignores it)
+class Thing:
+    pass
+def stop(ref):
+    os.kill(os.getpid(), signal.{sig})
+    for _ in range(1000):  # the handler runs between bytecodes: here, inside the callback
+        pass
+"""
+"""A child script's start: a signal handler as a user's shell leaves it, and ``stop``, a weak reference's
+callback that sends signal ``{sig}`` to the process and lets it land there (where Python cannot raise)."""
+
+
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
 def test_a_stop_that_lands_where_python_cannot_raise_is_quiet_and_still_a_stop(sig):
     """A signal during the heavy imports can land in importlib's module-lock clean-up (a weak reference's
@@ -279,18 +293,10 @@ def test_a_stop_that_lands_where_python_cannot_raise_is_quiet_and_still_a_stop(s
     import subprocess
     import sys
 
-    script = f"""
-import os, signal, sys, weakref
+    script = _STOP_IN_A_CALLBACK.format(sig=sig) + f"""
 from patterns import signals
 from patterns.errors import Terminated
-signal.signal(signal.SIGINT, signal.default_int_handler)  # as a user's shell gives it (.ci/run & ignores it)
 restore = signals.install()
-class Thing:
-    pass
-def stop(ref):
-    os.kill(os.getpid(), signal.{sig})
-    for _ in range(1000):  # the handler runs between bytecodes: here, inside the callback
-        pass
 thing = Thing(); ref = weakref.ref(thing, stop); del thing
 print("stop received:", signals.received() == signal.{sig}, flush=True)
 try:
@@ -361,15 +367,7 @@ def test_a_stop_quieted_during_the_heavy_imports_is_not_forgotten_by_the_run(tmp
     import sys
 
     out = tmp_path / "out.dxf"
-    script = f"""
-import os, signal, sys, weakref
-signal.signal(signal.SIGINT, signal.default_int_handler)  # as a user's shell gives it (.ci/run & ignores it)
-class Thing:
-    pass
-def stop(ref):
-    os.kill(os.getpid(), signal.{sig})
-    for _ in range(1000):  # the handler runs between bytecodes: here, inside the callback
-        pass
+    script = _STOP_IN_A_CALLBACK.format(sig=sig) + f"""
 fired = []
 def hook(event, args):
     if event == "import" and args[0] == "patterns.cli" and not fired:

@@ -294,7 +294,7 @@ def _traced(run: list, wall: int, *, chain: tuple, topology, faces: tuple, sheet
         (p0, uv0), (p1, uv1) = first[0], first[-1]
         inward = np.array([-normal(edges[0][1], *uv0[0]), -normal(edges[-1][1], *uv1[-1])])
         ends = _ends(topology, faces[wall], sheet.skin, wall, np.array([p0[0], p1[-1]]), inward)
-    done: list = [{} for _ in run]  # per edge: parameter -> (developed (2,), reached)
+    done: list = [{} for _ in run]  # per edge: parameter -> (developed (2,), reached, skin parameters (2,))
     for round_ in range(rounds):
         full = [np.insert(t, np.arange(1, len(t)), (t[:-1] + t[1:]) / 2) for t in ts]  # ends and middles
         new = [np.array([t for t in f if float(t) not in d]) for f, d in zip(full, done)]
@@ -306,8 +306,8 @@ def _traced(run: list, wall: int, *, chain: tuple, topology, faces: tuple, sheet
         if isinstance(got, str):
             return got, False
         at, _, rays = got
-        for j, ((ps, _), ds) in enumerate(zip(at, rays)):
-            for t, p, d in zip(new[j], ps, ds):
+        for j, ((ps, uvs), ds) in enumerate(zip(at, rays)):
+            for t, p, uv, d in zip(new[j], ps, uvs, ds):
                 found = layer.neutral(p, d, sheet.thickness / STEEP)
                 if found is None:
                     return ("its wall's line meets no neutral layer (two bends with no flat between them, whose "
@@ -315,15 +315,16 @@ def _traced(run: list, wall: int, *, chain: tuple, topology, faces: tuple, sheet
                 if not _holds(faces[wall], found[0], layer.surfaces):
                     return ("its wall changes within the sheet (a counterbore or a countersink: a step before the "
                             "neutral layer)"), False
-                done[j][float(t)] = (layer.developed(*found, maps=maps, motions=motions), found[1] in layer.bend_faces)
+                done[j][float(t)] = (layer.developed(*found, maps=maps, motions=motions), found[1] in layer.bend_faces,
+                                     uv)
         traced = [np.array([done[j][float(t)][0] for t in f]) for j, f in enumerate(full)]
         reached = any(done[j][float(t)][1] for j, f in enumerate(full) for t in f)
         kept = [t[1::2][_bowed(xy)] for t, xy in zip(full, traced)]
         if round_ == rounds - 1 or not any(len(k) for k in kept):
             break
         ts = [np.sort(np.concatenate([t, k]))[::-1 if t[0] > t[-1] else 1] for t, k in zip(ts, kept)]
-    at = [_at(edge, face, t) for (edge, face, _), t in zip(edges, full)]
-    skin = np.vstack([flat(maps, motions, chain[k][1], uvs) for k, (_, uvs) in zip(run, at)])
+    skin = np.vstack([flat(maps, motions, chain[k][1], np.array([done[j][float(t)][2] for t in f]))
+                      for j, (k, f) in enumerate(zip(run, full))])
     drawn = np.vstack(traced)
     off = max(float(np.max(shapely.distance(shapely.points(drawn), shapely.LineString(skin)))),
               float(np.max(shapely.distance(shapely.points(skin), shapely.LineString(drawn)))))
@@ -420,6 +421,7 @@ class _Layer:
     junctions: dict  # {flange: its junctions}
     spans: dict
     reaches: dict  # {flange: how far it reaches from each of its junctions (_reach), mm}
+    bend_faces: frozenset  # the faces of its bends
     surfaces: dict = field(default_factory=dict, compare=False)  # each face's projector, made once (_uv)
 
     @classmethod
@@ -451,12 +453,7 @@ class _Layer:
             by_flange.setdefault(x.flange, []).append(x)
         by_flange = {b: tuple(xs) for b, xs in sorted(by_flange.items())}
         reaches = {b: _reach(topology, b, xs) for b, xs in by_flange.items()}
-        return cls(faces, bends, tuple(groups), by_flange, spans, reaches, surfaces)
-
-    @property
-    def bend_faces(self) -> frozenset:
-        """The faces of the layer's bends."""
-        return frozenset(j for k in self.groups for j in self.bends[k].faces)
+        return cls(faces, bends, tuple(groups), by_flange, spans, reaches, frozenset(spans), surfaces)
 
     def _on_bend(self, k: int, p: np.ndarray, d: np.ndarray) -> list:
         """``[(s, q, face), ...]``: where the line ``p + s d`` (s > 0) meets bend ``k``'s neutral cylinder
