@@ -6,6 +6,7 @@ Run from the repository root::
     python benchmarks/bench_flatten.py --quick         # 1k surfaces, corpus meshes up to 10k faces
     python benchmarks/bench_flatten.py --sizes 1k,10k --no-corpus
     python benchmarks/bench_flatten.py --markdown > tables.md
+    python benchmarks/bench_flatten.py --folder DIR --sizes "" --extra-sizes ""   # the meshes of DIR only
 
 Meshes
 ------
@@ -1218,6 +1219,9 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser.add_argument("--no-memory", action="store_true",
                         help=f"skip the child-process peak-memory run of relaxed on meshes with >= {ACCEPT_1M} faces")
     parser.add_argument("--no-corpus", action="store_true", help="skip the shared corpus meshes")
+    parser.add_argument("--folder", action="append", type=Path, default=[],
+                        help="flatten the *.obj, *.off, *.obj.gz of this folder instead of the corpus and the "
+                             "thin limbs (repeatable; e.g. OptCuts' input/benchmark disks)")
     parser.add_argument("--max-corpus-faces", type=int, default=None,
                         help="leave out corpus meshes with more faces than this (default none left out)")
     parser.add_argument("--methods", default=",".join(DEFAULT_METHODS),
@@ -1245,13 +1249,19 @@ def parse_args(argv=None) -> argparse.Namespace:
 def mesh_sections(args) -> list:
     """``(title, iterator of (name, vertices, faces))`` of the corpus and the generated surfaces."""
     sections = []
-    if args.no_corpus:
+    for folder in args.folder:
+        if not folder.is_dir():
+            raise SystemExit(f"bench_flatten.py: --folder {folder}: not a folder")
+        sections.append((f"{folder.name} ({folder})", corpus_meshes(folder, args.max_corpus_faces)))
+    if args.folder:
+        pass
+    elif args.no_corpus:
         print("corpus: skipped (--no-corpus)")
     elif not CORPUS.is_dir():
         print(f"corpus: skipped ({CORPUS} does not exist)")
     else:
         sections.append(("Corpus (../shared/corpus/)", corpus_meshes(CORPUS, args.max_corpus_faces)))
-    if args.no_corpus:
+    if args.no_corpus or args.folder:
         pass
     elif not LIMBS.is_dir():
         print(f"thin limbs: skipped ({LIMBS} does not exist)")

@@ -11,6 +11,7 @@ reflection), never changing the one it is called on.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -43,9 +44,8 @@ class Motion:
     @property
     def matrix(self) -> np.ndarray:
         """(2, 2) float64: the linear part (determinant -1 when mirrored)."""
-        c, s = np.cos(self.angle), np.sin(self.angle)
-        rot = np.array([[c, -s], [s, c]])
-        return rot @ np.diag([-1.0, 1.0]) if self.mirrored else rot
+        c, s = float(np.cos(self.angle)), float(np.sin(self.angle))
+        return np.array([[-c, -s], [-s, c]]) if self.mirrored else np.array([[c, -s], [s, c]])
 
     @property
     def shift(self) -> np.ndarray:
@@ -53,12 +53,11 @@ class Motion:
 
     def __call__(self, points) -> np.ndarray:
         """(k, 2) or (2,) points moved, float64, mm (a new array)."""
-        p = np.asarray(points, dtype=np.float64)
-        return p @ self.matrix.T + self.shift
+        return _linear(self.matrix, np.asarray(points, dtype=np.float64)) + self.shift
 
     def direction(self, vectors) -> np.ndarray:
         """Directions (k, 2) or (2,) turned (and mirrored), not moved."""
-        return np.asarray(vectors, dtype=np.float64) @ self.matrix.T
+        return _linear(self.matrix, np.asarray(vectors, dtype=np.float64))
 
     def turn(self, degrees: float) -> float:
         """The angle (degrees) a direction at ``degrees`` points at once moved."""
@@ -66,15 +65,24 @@ class Motion:
         return float(np.degrees(np.arctan2(d[1], d[0])))
 
     def __matmul__(self, other: Motion) -> Motion:
-        m = self.matrix @ other.matrix
+        a, b = self.matrix, other.matrix
+        m = np.array([[a[0, 0] * b[0, 0] + a[0, 1] * b[1, 0], a[0, 0] * b[0, 1] + a[0, 1] * b[1, 1]],
+                      [a[1, 0] * b[0, 0] + a[1, 1] * b[1, 0], a[1, 0] * b[0, 1] + a[1, 1] * b[1, 1]]])
         shift = self(other.shift)
         mirrored = self.mirrored != other.mirrored
-        lin = m @ np.diag([-1.0, 1.0]) if mirrored else m
+        lin = m * np.array([-1.0, 1.0]) if mirrored else m  # m @ diag(-1, 1): the first column's sign
         return Motion(float(np.arctan2(lin[1, 0], lin[0, 0])), float(shift[0]), float(shift[1]), mirrored)
 
     @property
     def is_identity(self) -> bool:
         return self.angle == 0.0 and self.dx == 0.0 and self.dy == 0.0 and not self.mirrored
+
+
+def _linear(m: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``p @ m.T`` for ``p`` (k, 2) or (2,), written out: a BLAS product rounds by the CPU's kernels (fused
+    multiply-adds on one, not on another), and every coordinate of a written file passes through here."""
+    x, y = p[..., 0], p[..., 1]
+    return np.stack([m[0, 0] * x + m[0, 1] * y, m[1, 0] * x + m[1, 1] * y], axis=-1)
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,7 +102,7 @@ class Line:
 
     @property
     def length(self) -> float:
-        return float(np.linalg.norm(self.end - self.start))
+        return math.hypot(*(self.end - self.start))
 
     def moved(self, motion: Motion) -> Line:
         return Line(motion(self.start), motion(self.end))
@@ -154,7 +162,7 @@ class Arc:
         a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
         sweep = 4 * np.arctan(bulge)
         chord = b - a
-        half = 0.5 * np.linalg.norm(chord)
+        half = 0.5 * math.hypot(*chord)
         radius = half / abs(np.sin(sweep / 2))
         mid = 0.5 * (a + b)
         normal = np.array([-chord[1], chord[0]]) / (2 * half)

@@ -120,3 +120,50 @@ def test_darts_parting_and_gores_are_the_same_under_two_cpus_kernels():
     """The searches that decide: the cup's darts, the spline bowl parted into pieces with darts, the oblate
     dome in gores; each decision (a dart more or less, a gore count, a piece) the same, and every layout."""
     _same(_run_under_each(["cup darts", "spline bowl parted", "oblate dome gores"]))
+
+
+def _files_under_each(commands: list[list[str]], tmp_path: Path) -> dict:
+    """``{coretype: {file name: bytes}}``: each command line of ``patterns`` run in a folder of its own per
+    kernel set (this CPU's own and two others), the runs side by side."""
+    runs = {}
+    for coretype in _coretypes():
+        env = dict(os.environ)
+        env.pop("OPENBLAS_CORETYPE", None)
+        if coretype is not None:
+            env["OPENBLAS_CORETYPE"] = coretype
+        folder = tmp_path / (coretype or "own")
+        folder.mkdir()
+        code = f"from patterns.cli import main\nfor args in {commands!r}:\n    assert main(args) == 0, args"
+        runs[folder] = subprocess.Popen([sys.executable, "-c", code], env=env, cwd=folder,
+                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    out = {}
+    for folder, child in runs.items():
+        _, stderr = child.communicate(timeout=1200)
+        assert child.returncode == 0, stderr[-2000:]
+        out[folder.name] = {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
+    return out
+
+
+def test_the_files_written_are_the_same_bytes_under_two_cpus_kernels(tmp_path):
+    """What a cutter receives: the cup's pattern with its darts cut at 3 %, a 10 mm seam allowance and notches,
+    as DXF (lines, and arcs fitted with V notches), SVG and the JSON report, and the bracket's blank with its
+    bend sheet: byte for byte the same under the CPU's own kernels, Haswell's and Sandybridge's (any number
+    printed to its last digit).  A notch's direction (a BLAS dot product of a 2-vector), the arcs' fit and the
+    pieces' placement (a BLAS matrix product) moved last digits of the DXF between an AVX-512 CPU's own kernels
+    and Haswell's (2026-11-29)."""
+    cup, bracket = str(REPO / "samples" / "cup.step"), str(REPO / "samples" / "bracket.step")
+    out = _files_under_each([
+        ["flatten", cup, "-o", "cup.dxf", "--dart-strain", "0.03", "--seam-allowance", "10", "--report", "cup.json"],
+        ["flatten", cup, "-o", "cup.svg", "--dart-strain", "0.03", "--seam-allowance", "10"],
+        ["flatten", cup, "-o", "arcs.dxf", "--dart-strain", "0.03", "--seam-allowance", "10", "--arcs",
+         "--notch-style", "v"],
+        ["unfold", bracket, "-o", "bracket.dxf", "--bend-sheet", "bends.csv"],
+    ], tmp_path)
+    (a, first), *others = out.items()
+    assert sorted(first) == ["arcs.dxf", "bends.csv", "bracket.dxf", "cup.dxf", "cup.json", "cup.svg"]
+    darts = [len(panel["darts"]) for panel in json.loads(first["cup.json"])["panels"]]
+    assert sum(darts) >= 12 and b"BEND" in first["bracket.dxf"]  # the darts a search decided; bend lines drawn
+    for b, second in others:
+        assert sorted(second) == sorted(first)
+        for name in first:
+            assert first[name] == second[name], (name, "differs between", a, "and", b)

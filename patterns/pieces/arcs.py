@@ -23,6 +23,8 @@ contour stays ONE closed entity; its vertices are points of the outline.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = ["arc_points", "fit_arcs"]
@@ -40,7 +42,7 @@ def _line(run: np.ndarray, tol: float) -> bool:
     if length == 0.0:
         return False
     d = run - a
-    along = d @ chord / length
+    along = (d[:, 0] * chord[0] + d[:, 1] * chord[1]) / length
     across = (d[:, 0] * chord[1] - d[:, 1] * chord[0]) / length
     return bool(np.abs(across).max() <= tol and along.min() >= -tol and along.max() <= length + tol)
 
@@ -67,12 +69,12 @@ def _arc(run: np.ndarray, tol: float, sampled: np.ndarray) -> float | None:
     mid = 0.5 * (a + b)
     normal = np.array([a[1] - b[1], b[0] - a[0]]) / (2.0 * half)
     d = run[1:-1] - mid
-    s = d @ normal
-    ss = float(s @ s)
+    s = d[:, 0] * normal[0] + d[:, 1] * normal[1]
+    ss = math.fsum(s * s)
     if ss == 0.0:
         return None
     # |p - mid - t n|^2 = half^2 + t^2  <=>  |p - mid|^2 - half^2 = 2 t (p - mid).n, in least squares:
-    t = float(((d * d).sum(axis=1) - half * half) @ s / (2.0 * ss))
+    t = math.fsum(((d * d).sum(axis=1) - half * half) * s) / (2.0 * ss)
     res = np.hypot(d[:, 0] - t * normal[0], d[:, 1] - t * normal[1]) - np.hypot(half, t)
     worst = float(np.abs(res).max())
     if worst > 3.0 * tol:
@@ -82,11 +84,11 @@ def _arc(run: np.ndarray, tol: float, sampled: np.ndarray) -> float | None:
         rel = d - t * normal
         dist = np.hypot(rel[:, 0], rel[:, 1])
         res = dist - radius
-        jac = -(rel @ normal) / dist - t / radius
-        jj = float(jac @ jac)
+        jac = -(rel[:, 0] * normal[0] + rel[:, 1] * normal[1]) / dist - t / radius
+        jj = math.fsum(jac * jac)
         if jj == 0.0:
             break
-        step = -float(jac @ res) / jj
+        step = -math.fsum(jac * res) / jj
         t += step
         if abs(step) <= 1e-12 * (abs(t) + half):
             break
@@ -257,7 +259,7 @@ def arc_points(fitted: np.ndarray, *, step: float = 0.01) -> np.ndarray:
             out.append(p0[None, :])
             continue
         sweep = 4.0 * np.arctan(bulge)
-        chord = np.linalg.norm(p1 - p0)
+        chord = math.hypot(*(p1 - p0))
         radius = chord / (2.0 * abs(np.sin(sweep / 2.0)))
         mid = 0.5 * (p0 + p1)
         normal = np.array([-(p1 - p0)[1], (p1 - p0)[0]]) / chord

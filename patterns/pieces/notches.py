@@ -13,6 +13,8 @@ notched where they meet the outline, and its point is a drill hole.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import shapely
 
@@ -57,7 +59,7 @@ def notch_positions(flat_seam, side: int, uv: np.ndarray, spacing: float | None)
         t = (s - c3[j]) / max(c3[j + 1] - c3[j], 1e-300)
         point = pts[j] + t * (pts[j + 1] - pts[j])
         tangent = pts[j + 1] - pts[j]
-        out.append((float(s), point, tangent / max(np.linalg.norm(tangent), 1e-300)))
+        out.append((float(s), point, _unit(tangent)))
     return out
 
 
@@ -115,7 +117,7 @@ def _notch(cut, geo, point, inward, depth):
             hits = shapely.get_coordinates(meet)
             if len(hits) and shapely.get_type_id(meet) in (0, 4):  # points, not a run along the cut line
                 start = hits[np.argmin(np.linalg.norm(hits - at, axis=1))]
-                gap = float(np.linalg.norm(start - at))
+                gap = math.hypot(*(start - at))
                 inside = shapely.points(start + np.linspace(0.1, 0.9, 9)[:, None] * (at - start))
                 along_cut = shapely.distance(cut.boundary, inside).min() < 1e-3  # partly on a step of it
                 if not along_cut and (abs(gap - depth) < 1e-6 or (at is point and gap > 1e-9)):
@@ -130,11 +132,11 @@ def _notch(cut, geo, point, inward, depth):
         if len(k):
             i = int(k[0])
             before, after = loop[i] - loop[i - 1], loop[(i + 1) % len(loop)] - loop[i]
-            normals = [np.array([-d[1], d[0]]) / max(np.linalg.norm(d), 1e-300) for d in (before, after)]
-            if normals[0] @ normals[1] < np.cos(np.radians(10)):
+            normals = [_unit(np.array([-d[1], d[0]])) for d in (before, after)]
+            if float(normals[0][0] * normals[1][0] + normals[0][1] * normals[1][1]) < np.cos(np.radians(10)):
                 bisector = normals[0] + normals[1]
-                if np.linalg.norm(bisector) > 1e-9:
-                    direction = bisector / np.linalg.norm(bisector)
+                if math.hypot(*bisector) > 1e-9:
+                    direction = _unit(bisector)
                     if not shapely.contains_xy(cut, *(point + 0.5 * direction)):
                         direction = -direction
             break
@@ -165,7 +167,7 @@ def _dart_mouths(flat, geo, *, across: bool) -> list:
         for leg in dart.legs:
             mouth = geo.uv[leg[0]]
             along = geo.uv[leg[1]] - mouth
-            along = along / max(np.linalg.norm(along), 1e-300)
+            along = _unit(along)
             if across:
                 normal = np.array([along[1], -along[0]])
             else:
@@ -173,9 +175,8 @@ def _dart_mouths(flat, geo, *, across: bool) -> list:
                 at = int(np.flatnonzero(loop == leg[0])[0])
                 nbrs = [int(loop[at - 1]), int(loop[(at + 1) % len(loop)])]
                 rim = geo.uv[nbrs[1] if nbrs[0] == leg[1] else nbrs[0]] - mouth
-                normal = -(along + rim / max(np.linalg.norm(rim), 1e-300))
-                normal = normal / max(np.linalg.norm(normal), 1e-300)
-            probe = mouth + 0.25 * float(np.linalg.norm(geo.uv[leg[1]] - mouth)) * normal
+                normal = _unit(-(along + _unit(rim)))
+            probe = mouth + 0.25 * math.hypot(*(geo.uv[leg[1]] - mouth)) * normal
             if shapely.contains_xy(geo.polygon, *probe):
                 normal = -normal  # outward = away from the piece
             out.append((mouth, normal))
@@ -185,3 +186,9 @@ def _dart_mouths(flat, geo, *, across: bool) -> list:
 def drill_holes(flat, geo) -> np.ndarray:
     """(d, 2) float64, mm, placed: the tip of each dart (a drill hole marks it, on the DRILL layer or ASTM 13)."""
     return np.array([geo.uv[dart.tip] for dart in flat.darts]).reshape(-1, 2)
+
+
+def _unit(d: np.ndarray) -> np.ndarray:
+    """``d`` ``(2,) float64`` over its length (math.hypot: no BLAS dot product, whose last bit follows the CPU's
+    kernels and would move a notch in the file written)."""
+    return d / max(math.hypot(d[0], d[1]), 1e-300)
