@@ -28,6 +28,7 @@ import numpy as np
 import shapely
 
 from ..curves import Loop, Polyline
+from ..tessellate.topology import Topology
 from .contour import edge_parameters, edge_piece
 from .faces import SheetFace, normal, point, uv_mid
 from .join import flat
@@ -223,20 +224,42 @@ def _square_wall(face: SheetFace, ps: np.ndarray, inward: np.ndarray, thickness:
     return True
 
 
-def _reach(topology, b: int, xs: tuple) -> tuple:
+def _reach(topology: Topology, b: int, xs: tuple) -> tuple:
     """How far flange ``b`` reaches from each of its junctions ``xs``, along the junction's ``side`` (mm): the
-    furthest of its edges, sampled at 1e-5 mm chord error (its free end, or its next bend)."""
+    furthest of its edges, sampled at 1e-5 mm chord error (its free end, or its next bend).  Only the edges
+    whose bounding box reaches past the furthest point found so far are sampled (a flange's holes never are)."""
+    from OCP.Bnd import Bnd_Box
     from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepBndLib import BRepBndLib
 
-    points = []
-    for walk in topology.wires[b]:
-        for _, edge in walk:
-            curve = BRepAdaptor_Curve(edge)
-            for t in edge_parameters(edge, 1e-5, reverse=False):
-                p = curve.Value(float(t))
-                points.append((p.X(), p.Y(), p.Z()))
-    points = np.array(points)
-    return tuple(float(np.max((points - x.axis_point) @ x.side)) for x in xs)
+    edges = [edge for walk in topology.wires[b] for _, edge in walk]
+    corners = []
+    for edge in edges:
+        box = Bnd_Box()
+        BRepBndLib.Add_s(edge, box)
+        lo, hi = box.CornerMin(), box.CornerMax()
+        x0, y0, z0, x1, y1, z1 = lo.X(), lo.Y(), lo.Z(), hi.X(), hi.Y(), hi.Z()
+        corners.append([(x, y, z) for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)])
+    corners = np.array(corners)  # (edges, 8, 3)
+    sampled: dict = {}
+    out = []
+    for x in xs:
+        def along(q: np.ndarray) -> np.ndarray:  # written out: no BLAS product (the CPU's kernels round it)
+            d = q - x.axis_point
+            return d[..., 0] * x.side[0] + d[..., 1] * x.side[1] + d[..., 2] * x.side[2]
+
+        bound = along(corners).max(axis=1)
+        best = -np.inf
+        for i in sorted(range(len(edges)), key=lambda i: (-bound[i], i)):
+            if bound[i] < best:
+                break
+            if i not in sampled:
+                curve = BRepAdaptor_Curve(edges[i])
+                sampled[i] = np.array([(q.X(), q.Y(), q.Z()) for q in (
+                    curve.Value(float(t)) for t in edge_parameters(edges[i], 1e-5, reverse=False))])
+            best = max(best, float(along(sampled[i]).max()))
+        out.append(best)
+    return tuple(out)
 
 
 def _bowed(xy: np.ndarray) -> np.ndarray:
@@ -420,9 +443,17 @@ class _Layer:
     groups: tuple
     junctions: dict  # {flange: its junctions}
     spans: dict
-    reaches: dict  # {flange: how far it reaches from each of its junctions (_reach), mm}
     bend_faces: frozenset  # the faces of its bends
+    topology: Topology = field(compare=False)  # the part's: its flanges' wires, for reach
     surfaces: dict = field(default_factory=dict, compare=False)  # each face's projector, made once (_uv)
+    reaches: dict = field(default_factory=dict, compare=False)  # {flange: reach(flange)}, each found once
+
+    def reach(self, b: int) -> tuple:
+        """How far flange ``b`` reaches from each of its junctions (:func:`_reach`, mm), found the first time a
+        line meets its plane (most flanges of a part never are: sampling all their edges was half an unfold)."""
+        if b not in self.reaches:
+            self.reaches[b] = _reach(self.topology, b, self.junctions[b])
+        return self.reaches[b]
 
     @classmethod
     def of(cls, groups: list, *, topology, faces: tuple, sheet: SheetModel, bends: tuple, surfaces: dict) -> _Layer:
@@ -452,8 +483,7 @@ class _Layer:
         for x in junctions:
             by_flange.setdefault(x.flange, []).append(x)
         by_flange = {b: tuple(xs) for b, xs in sorted(by_flange.items())}
-        reaches = {b: _reach(topology, b, xs) for b, xs in by_flange.items()}
-        return cls(faces, bends, tuple(groups), by_flange, spans, reaches, frozenset(spans), surfaces)
+        return cls(faces, bends, tuple(groups), by_flange, spans, frozenset(spans), topology, surfaces)
 
     def _on_bend(self, k: int, p: np.ndarray, d: np.ndarray) -> list:
         """``[(s, q, face), ...]``: where the line ``p + s d`` (s > 0) meets bend ``k``'s neutral cylinder
@@ -499,7 +529,7 @@ class _Layer:
         q = p + s * d
         if s <= -1e-9 or not all(y.on_flange(q) for y in xs):
             return []
-        if any(float((q - y.axis_point) @ y.side) > reach + 1e-6 for y, reach in zip(xs, self.reaches[b])):
+        if any(float((q - y.axis_point) @ y.side) > reach + 1e-6 for y, reach in zip(xs, self.reach(b))):
             return []  # past the flange's free end: under no skin of it
         return [(float(s), q, b)]
 
