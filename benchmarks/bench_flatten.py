@@ -110,6 +110,7 @@ import trimesh
 
 import patterns
 from patterns import surfaces
+from patterns.launch import one_run_allocator
 from patterns.measure import folded_faces
 
 CORPUS = REPO.parent / "shared" / "corpus"
@@ -763,9 +764,12 @@ def run_libigl(name: str, vertices, faces, method: str, repeats: int, loops, max
 # --------------------------------------------------------------------------- #
 
 RSS_CHILD = """\
-import json, resource, sys, time
+import json, os, resource, sys, time
 import numpy as np
 import patterns
+from patterns.launch import one_run_allocator
+if os.environ.get("BENCH_ALLOCATOR") == "command":
+    one_run_allocator()
 
 def high_water_kib():
     # VmHWM belongs to the memory map made by exec, so unlike ru_maxrss (which on
@@ -1202,7 +1206,8 @@ lscm: igl.lscm, two farthest boundary vertices pinned; its uv is RESCALED by one
 arap: igl harmonic init (boundary on a circle) + arap_precomputation/arap_solve, 2D, default 10 iterations,
   one vertex held (translation only); time includes the harmonic init.
 slim: igl.slim_solve, symmetric Dirichlet, {slim} iterations, from Tutte's embedding (uniform weights), included in the time.
-All rows measured by patterns.distortion and patterns.overlap_verdict (outside the timed region)."""
+All rows measured by patterns.distortion and patterns.overlap_verdict (outside the timed region).
+Allocator: {allocator}."""
 
 
 def parse_args(argv=None) -> argparse.Namespace:
@@ -1227,6 +1232,10 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser.add_argument("--methods", default=",".join(DEFAULT_METHODS),
                         help=f"comma-separated subset of {','.join(ALL_METHODS)} "
                              f"(default {','.join(DEFAULT_METHODS)})")
+    parser.add_argument("--allocator", choices=("command", "default"), default="command",
+                        help="command (default): this whole process, every method's runs and the memory child, "
+                             "with the C allocator set as the patterns command sets it for itself "
+                             "(patterns.launch.one_run_allocator); default: as Python leaves it")
     parser.add_argument("--markdown", action="store_true",
                         help="print the tables as markdown (for docs/benchmarks.md) at the end")
     parser.add_argument("--max-faces-conformal", type=int, default=200_000,
@@ -1277,7 +1286,15 @@ def main(argv=None) -> int:
     """Command-line entry point; see ``--help``."""
     args = parse_args(argv)
     methods = args.methods
-    print(HEADER.format(limit=REPEAT_LIMIT, slim=SLIM_ITERATIONS, seed=SHUFFLE_SEED))
+    os.environ["BENCH_ALLOCATOR"] = args.allocator  # the memory child's too
+    if args.allocator == "command":
+        took = one_run_allocator()
+        allocator = ("as the patterns command sets it (patterns.launch.one_run_allocator: freed blocks up to 32 MB "
+                     "kept for the next, the heap never trimmed), for every method alike" if took else
+                     "Python's default (this C library takes no mallopt settings)")
+    else:
+        allocator = "Python's default (--allocator default)"
+    print(HEADER.format(limit=REPEAT_LIMIT, slim=SLIM_ITERATIONS, seed=SHUFFLE_SEED, allocator=allocator))
     print(machine_summary())
     print()
 

@@ -417,3 +417,37 @@ def test_a_pattern_is_never_written_under_a_suffix_of_another_format(tmp_path):
                                                       r"write \.csv, \.dxf, \.json, \.svg"):
             patterns.write(pattern, tmp_path / name)
     assert not list(tmp_path.iterdir())
+
+
+_FREED = r'''
+import sys
+import numpy as np
+from patterns.launch import one_run_allocator
+
+took = one_run_allocator() if sys.argv[1] == "one run" else None
+
+
+def rss():  # kB: this process's resident set now
+    with open("/proc/self/status") as status:
+        return next(int(line.split()[1]) for line in status if line.startswith("VmRSS:"))
+
+
+block = np.ones(20 * 2**20 // 8)  # 20 MB, written: resident
+before = rss()
+del block
+print(took, before - rss())
+'''
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's allocator, read in /proc")
+def test_a_one_run_process_keeps_the_memory_it_frees_and_a_default_one_gives_it_back():
+    """``patterns.launch.one_run_allocator`` (what the ``patterns`` command sets for itself): a 20 MB array
+    freed stays with the process, for the next one (no page to fault in again); without it glibc gives the
+    block back to the system at once."""
+    runs = {}
+    for mode in ("default", "one run"):
+        out = subprocess.run([sys.executable, "-c", _FREED, mode], capture_output=True, text=True, check=True)
+        took, dropped = out.stdout.split()
+        runs[mode] = took, int(dropped)
+    assert runs["default"][1] > 15_000  # kB: the 20 MB went back
+    assert runs["one run"] == ("True", runs["one run"][1]) and runs["one run"][1] < 2_000
