@@ -31,11 +31,13 @@ def one_run_allocator() -> bool:
     MALLOC_TRIM_THRESHOLD_=2147483647`` in its environment.  Returns whether the C library took the settings
     (False where it is not glibc's: nothing changes).
     """
+    if not sys.platform.startswith("linux"):  # glibc's knobs (Windows has no C library to open by None)
+        return False
     import ctypes
 
     try:
         mallopt = ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):  # no C library to ask (Windows), or one without mallopt (macOS)
+    except (OSError, AttributeError):  # a C library without mallopt
         return False
     mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
     return bool(mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD)) and bool(mallopt(_M_TRIM_THRESHOLD, 2**31 - 1))
@@ -46,7 +48,7 @@ def main() -> int:
     restore = None
     try:
         restore = signals.install()  # cli.main installs them again, nested: one run; these come back after both
-        if sys.argv[1:2] != ["serve"] and sys.platform.startswith("linux"):
+        if sys.argv[1:2] != ["serve"]:
             one_run_allocator()
         try:
             from .cli import main as run

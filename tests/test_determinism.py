@@ -79,24 +79,36 @@ def _coretypes() -> tuple:
     pytest.skip("a CPU without AVX: one kernel set only")
 
 
-def _run_under_each(cases: list) -> dict:
-    """``{coretype: {case: {"pieces", "layout"}}}``, the children run side by side (``"own"``: this CPU's own
-    kernels)."""
+def _children(code: str, args: list, folders: Path | None = None) -> dict:
+    """``{coretype: (stdout, its folder or None)}``: ``python -c code *args`` run under this CPU's own kernels
+    (``"own"``) and two other kernel sets, side by side, each in a folder of its own under ``folders`` where
+    given; every child checked to have ended well and taken the kernels it was given."""
     runs = {}
     for coretype in _coretypes():
+        name = coretype or "own"
         env = dict(os.environ, OPENBLAS_VERBOSE="2")
         env.pop("OPENBLAS_CORETYPE", None)
         if coretype is not None:
             env["OPENBLAS_CORETYPE"] = coretype
-        runs[coretype or "own"] = subprocess.Popen([sys.executable, "-c", CHILD, str(REPO), *cases], env=env,
-                                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        folder = None if folders is None else folders / name
+        if folder is not None:
+            folder.mkdir()
+        runs[name] = folder, subprocess.Popen([sys.executable, "-c", code, *args], env=env, cwd=folder,
+                                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     out = {}
-    for coretype, child in runs.items():
+    for name, (folder, child) in runs.items():
         stdout, stderr = child.communicate(timeout=1200)
         assert child.returncode == 0, stderr[-2000:]
-        assert f"Core: {coretype}" in stderr or coretype == "own"  # OpenBLAS says the kernels it took
-        out[coretype] = json.loads(stdout.strip().splitlines()[-1])
+        assert f"Core: {name}" in stderr or name == "own"  # OpenBLAS says the kernels it took
+        out[name] = stdout, folder
     return out
+
+
+def _run_under_each(cases: list) -> dict:
+    """``{coretype: {case: {"pieces", "layout"}}}``, the children run side by side (``"own"``: this CPU's own
+    kernels)."""
+    return {name: json.loads(stdout.strip().splitlines()[-1])
+            for name, (stdout, _) in _children(CHILD, [str(REPO), *cases]).items()}
 
 
 def _same(out: dict) -> None:
@@ -125,23 +137,9 @@ def test_darts_parting_and_gores_are_the_same_under_two_cpus_kernels():
 def _files_under_each(commands: list[list[str]], tmp_path: Path) -> dict:
     """``{coretype: {file name: bytes}}``: each command line of ``patterns`` run in a folder of its own per
     kernel set (this CPU's own and two others), the runs side by side."""
-    runs = {}
-    for coretype in _coretypes():
-        env = dict(os.environ)
-        env.pop("OPENBLAS_CORETYPE", None)
-        if coretype is not None:
-            env["OPENBLAS_CORETYPE"] = coretype
-        folder = tmp_path / (coretype or "own")
-        folder.mkdir()
-        code = f"from patterns.cli import main\nfor args in {commands!r}:\n    assert main(args) == 0, args"
-        runs[folder] = subprocess.Popen([sys.executable, "-c", code], env=env, cwd=folder,
-                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    out = {}
-    for folder, child in runs.items():
-        _, stderr = child.communicate(timeout=1200)
-        assert child.returncode == 0, stderr[-2000:]
-        out[folder.name] = {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
-    return out
+    code = f"from patterns.cli import main\nfor args in {commands!r}:\n    assert main(args) == 0, args"
+    return {name: {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
+            for name, (_, folder) in _children(code, [], tmp_path).items()}
 
 
 def test_the_files_written_are_the_same_bytes_under_two_cpus_kernels(tmp_path):
