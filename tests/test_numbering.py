@@ -51,6 +51,21 @@ def test_a_dissection_order_is_a_permutation_that_keeps_the_factor_thin():
     assert _fill(laplacian, order) < 40 * n
 
 
+@pytest.mark.parametrize("bits", [1, 2, 20, 41, 53, 63, 64])
+def test_the_highest_set_bit_is_python_s_bit_length_less_one(bits):
+    """Both ways the dissection finds an edge's cut level: by the float exponent (codes under 2**53, every
+    2D code) and bit by bit (a 3D code), checked against Python's own integers, powers of two and their
+    neighbours included (where a float would round up)."""
+    from patterns.flattening.numbering import _highest_bit
+
+    rng = np.random.default_rng(bits)
+    top = (1 << bits) - 1
+    values = [1, top, 1 << (bits - 1), max(1, (1 << (bits - 1)) - 1), max(1, top - 1)]
+    values += [int(x) for x in rng.integers(1, min(top, 2**63 - 1), size=200, dtype=np.uint64, endpoint=True)]
+    x = np.array(values, dtype=np.uint64)
+    assert np.asarray(_highest_bit(x)).tolist() == [v.bit_length() - 1 for v in values]
+
+
 def test_the_last_vertices_numbered_cut_the_mesh_into_blocks_numbered_before_them():
     """Nested dissection's defining property: a short run of vertices numbered last
     (the top cut) separates the rest into pieces, each numbered as one block."""

@@ -380,7 +380,7 @@ class _System:
 
 
 class _Memory:
-    """L-BFGS pairs with their preconditioned ``H0 y``, and the two-loop recursion."""
+    """L-BFGS pairs with their preconditioned ``H0 y`` and ``s . y``, and the two-loop recursion."""
 
     def __init__(self):
         self.pairs = []
@@ -389,26 +389,28 @@ class _Memory:
         self.pairs = []
 
     def add(self, s, y, hy):
-        if dot(s, y) > 0:
-            self.pairs.append((s, y, hy))
+        sy = dot(s, y)
+        if sy > 0:
+            self.pairs.append((s, y, hy, sy))
             del self.pairs[:-_MEMORY]
 
     def direction(self, grad, hgrad) -> np.ndarray:
         """``H grad`` by the two-loop recursion; ``H0`` products come precomputed (``hgrad``, ``H0 y``)."""
         alphas = []
-        for s, y, _ in reversed(self.pairs):
-            alphas.append(dot(s, grad) / dot(y, s))
-            grad = grad - alphas[-1] * y
+        q = grad.copy()
+        for s, y, _, sy in reversed(self.pairs):
+            alphas.append(dot(s, q) / sy)
+            q -= alphas[-1] * y
         r = hgrad.copy()  # H0 q = H0 g - sum a_i H0 y_i (H0 is linear)
-        for (_, _, hy), a in zip(reversed(self.pairs), alphas):
+        for (_, _, hy, _), a in zip(reversed(self.pairs), alphas):
             r -= a * hy
         if self.pairs:
-            s, y, hy = self.pairs[-1]
+            s, y, hy, sy = self.pairs[-1]
             yhy = dot(y, hy)
             if yhy > 0:  # H0's curvature along y: rounds to 0 where y is tiny (the spline bowl on an AMD EPYC)
-                r *= dot(s, y) / yhy
-        for (s, y, _), a in zip(self.pairs, reversed(alphas)):
-            r += (a - dot(y, r) / dot(y, s)) * s
+                r *= sy / yhy
+        for (s, y, _, sy), a in zip(self.pairs, reversed(alphas)):
+            r += (a - dot(y, r) / sy) * s
         return r
 
 
@@ -437,6 +439,14 @@ class _Minimiser:
 
     def restrict(self, g):
         return g if self.everywhere else g[self.free]
+
+    def downhill(self, uv, d):
+        """``-d`` on the free vertices, 0 on the pinned: a step ``(n, 2)`` for the layout ``uv``."""
+        if self.everywhere:
+            return -d
+        out = np.zeros_like(uv)
+        out[self.free] = -d
+        return out
 
     def evaluate(self, u, mu):
         """``(value, gradient on the free vertices, parts)``; value inf where folded."""
@@ -470,7 +480,9 @@ class _Minimiser:
         mu = float(barrier)
         self.size = layout_size(uv)
         value, grad, parts = self.evaluate(uv, mu)
-        lu, hgrad, memory = self.factor(uv, mu), None, _Memory()
+        # pending: the last step's (s, y, H0 grad before it), its pair completed by the next iteration's solve
+        # (a run that stops after a step makes no solve for it)
+        lu, hgrad, memory, pending = self.factor(uv, mu), None, _Memory(), None
         since_refresh, recent, rounds = 0, [value], 0
         stiff = self.sd or self.newton or mu > 0
         iterations = 0
@@ -479,19 +491,21 @@ class _Minimiser:
             if stiff and since_refresh >= self.refresh:
                 fresh, since_refresh = self.factor(uv, mu), 0
                 if fresh is not lu:
-                    lu, hgrad = fresh, None
+                    lu, hgrad, pending = fresh, None, None
                     memory.clear()
             since_refresh += 1
             if hgrad is None:
                 hgrad = lu.solve(grad)
+                if pending is not None:
+                    memory.add(pending[0], pending[1], hgrad - pending[2])
+                    pending = None
             moved, step = self.line_search(uv, value, grad, hgrad, memory, mu)
             if moved:
                 cand, new_value, new_grad, new_parts = step
-                new_hgrad = lu.solve(new_grad)
-                memory.add(self.restrict(cand - uv), new_grad - grad, new_hgrad - hgrad)
+                pending = (self.restrict(cand - uv), new_grad - grad, hgrad)
                 if stiff and new_value < _JUMP * value:
                     since_refresh = self.refresh  # a crushed triangle opened: matrix and pairs made far from here
-                uv, value, grad, hgrad, parts = cand, new_value, new_grad, new_hgrad, new_parts
+                uv, value, grad, hgrad, parts = cand, new_value, new_grad, None, new_parts
             if self.progress is not None:
                 self.progress(self.offset + iterations, self.total)
             if not moved and memory.pairs:
@@ -515,18 +529,17 @@ class _Minimiser:
                 mu = mu * _DROP if mu > _WEAKEST * 1.5 else 0.0
                 stiff = self.sd or self.newton or mu > 0
                 value, grad = self.reweigh(parts, mu)  # the terms are at hand
-            lu, hgrad, since_refresh, recent = self.factor(uv, mu), None, 0, [value]
+            lu, hgrad, since_refresh, recent, pending = self.factor(uv, mu), None, 0, [value], None
             memory.clear()
         return uv, iterations, False
 
     def line_search(self, uv, value, grad, hgrad, memory, mu):
         """``(moved, (uv, value, grad, parts))`` along the L-BFGS direction, flip-free and non-crossing."""
-        direction = np.zeros_like(uv)
-        direction[self.free] = -memory.direction(grad, hgrad)
+        direction = self.downhill(uv, memory.direction(grad, hgrad))
         slope = dot(grad, self.restrict(direction))
         if not slope < 0:  # stale memory: fall back to the preconditioned gradient
             memory.clear()
-            direction[self.free] = -hgrad
+            direction = self.downhill(uv, hgrad)
             slope = dot(grad, self.restrict(direction))
         step = min(1.0, 0.9 * float(flip_free_steps(uv, self.faces, direction, horizon=1.0 / 0.9,
                                                      corners=self.objective.fr.corners).min()))
