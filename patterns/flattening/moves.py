@@ -17,7 +17,7 @@ import shapely
 
 from ..errors import InputError
 from ..measure import signed_areas
-from ..mesh import Connectivity
+from ..mesh import Connectivity, extent
 from ..predicates import crossing_segments
 
 __all__ = [
@@ -141,7 +141,7 @@ def edge_index(table: np.ndarray, edges: np.ndarray) -> np.ndarray:
 
 def layout_size(uv: np.ndarray) -> float:
     """The layout's larger extent, mm (1 for a point)."""
-    return float(np.ptp(uv, axis=0).max()) or 1.0
+    return extent(uv) or 1.0
 
 
 def safe_move(faces: np.ndarray, loops, uv: np.ndarray, target: np.ndarray, *, tries: int = 40) -> np.ndarray:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mesh import Connectivity, _readonly
+from ..mesh import Connectivity, _readonly, bounds
 
 __all__ = ["Numbering", "dissection_order", "renumber", "renumber_connectivity", "spatial_order"]
 
@@ -48,8 +48,8 @@ def _morton(points: np.ndarray) -> np.ndarray:
     d = points.shape[1]
     if len(points) == 0:
         return np.zeros(0, dtype=np.uint64)
-    lo = points.min(axis=0)
-    span = float(np.ptp(points, axis=0).max()) or 1.0
+    lo, hi = bounds(points)
+    span = float((hi - lo).max()) or 1.0
     top = 2 ** _BITS[d] - 1
     q = np.clip((points - lo) / span * top, 0, top).astype(np.uint64)
     code = np.zeros(len(points), dtype=np.uint64)
