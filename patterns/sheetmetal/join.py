@@ -26,8 +26,12 @@ MEET = 0.01
 def _kabsch(src: np.ndarray, dst: np.ndarray) -> Motion:
     """The rigid motion (never a mirror) taking ``src`` (k, 2) closest to ``dst``."""
     cs, cd = src.mean(axis=0), dst.mean(axis=0)
-    h = (src - cs).T @ (dst - cd)
-    angle = float(np.arctan2(h[0, 1] - h[1, 0], h[0, 0] + h[1, 1]))
+    a, b = src - cs, dst - cd
+    # The cross-covariance written out: a BLAS product (``a.T @ b``) rounds by the CPU's kernels, and every
+    # face's place on the blank would follow them (issue 51).
+    sin = float(np.sum(a[:, 0] * b[:, 1]) - np.sum(a[:, 1] * b[:, 0]))
+    cos = float(np.sum(a[:, 0] * b[:, 0]) + np.sum(a[:, 1] * b[:, 1]))
+    angle = float(np.arctan2(sin, cos))
     turn = Motion(angle)
     shift = cd - turn(cs)
     return Motion(angle, float(shift[0]), float(shift[1]))
