@@ -60,16 +60,17 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=1, help="best of this many runs of each (default 1)")
     parser.add_argument("--corpus", type=Path, default=CORPUS, help=f"the meshes (default {CORPUS})")
     args = parser.parse_args(argv)
-    if not args.corpus.is_dir():
-        print(f"{args.corpus} does not exist: nothing to compare")
-        return 0
-    meshes = sorted(p for p in args.corpus.iterdir() if p.suffix.lower() in (".obj", ".off", ".ply", ".stl"))
     head = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True,
                           text=True, check=True).stdout.strip()
     if subprocess.run(["git", "-C", str(REPO), "diff", "--quiet", args.commit, "--", "patterns"]).returncode == 0:
         print(f"same_as: {args.commit}'s patterns/ is this checkout's (edits included): that compares the engine "
               f"with itself; name an earlier commit", file=sys.stderr)
         return 2
+    # after the refusal: a clone with no ../shared refuses to compare the engine with itself as well
+    if not args.corpus.is_dir():
+        print(f"{args.corpus} does not exist: nothing to compare")
+        return 0
+    meshes = sorted(p for p in args.corpus.iterdir() if p.suffix.lower() in (".obj", ".off", ".ply", ".stl"))
     with tempfile.TemporaryDirectory(prefix="patterns-same-as-") as tmp:
         old = Path(tmp) / "old"
         subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(old), args.commit],
