@@ -17,6 +17,7 @@ from .curves import Motion
 from .errors import InputError
 from .findings import Code, Finding, Severity
 from .measure import edge_strain, folded_faces, strain_stats
+from .mesh import extent
 from .model import Bookkeeping
 from .options import Options, option
 from .pattern import Pattern
@@ -297,7 +298,7 @@ def _unit_notes(pattern: Pattern) -> list:
     (metres, then centimetres, then inches), and how to say it."""
     if not pattern.panels:
         return []
-    size = max(float(np.ptp(flat.uv, axis=0).max()) for flat in pattern.panels)
+    size = max(extent(flat.uv) for flat in pattern.panels)
     if size >= TINY:
         return []
     unit, scale = next(((u, mm) for u, mm in (("m", 1000.0), ("cm", 10.0), ("in", 25.4)) if size * mm >= 10.0),

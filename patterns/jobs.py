@@ -29,8 +29,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-import numpy as np
-
 from .audit import Report, check, checked_drawing
 from .blank import Blank
 from .bundle import Bundle
@@ -40,6 +38,7 @@ from .export import WriteOptions, heat_map, preview_dxf, write, write_flat_obj
 from .export.registry import profile_for
 from .files import output_target
 from .flattening import flatten
+from .mesh import extent
 from .model import Model
 from .nesting import Layout, check_piece_count, layout
 from .pattern import Pattern
@@ -136,7 +135,7 @@ def check_part(model: Model, bundle: Bundle, outputs: dict) -> None:
         raise InputError(f"{model.name}: {len(model.panels)} panels; a flat .obj holds one, write a .dxf")
     if bundle.pieces is not None:
         check_marks(model.name, [s.length for s in model.seams],
-                    [float(np.ptp(p.vertices, axis=0).max()) for p in model.panels], bundle.pieces)
+                    [extent(p.vertices) for p in model.panels], bundle.pieces)
     nesting = bundle.nest
     if nesting is not None and nesting.active:  # a panel a piece (gores and darts may add more, checked again)
         quantities = nesting.quantities or {}

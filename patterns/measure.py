@@ -36,6 +36,7 @@ __all__ = [
     "affine_coefficients",
     "angle_defects",
     "area_ratio",
+    "best_turn",
     "boundary_lengths",
     "distortion",
     "edge_strain",
@@ -126,6 +127,28 @@ def _stretches(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
     """``(m, 2)`` principal stretches ``|alpha| + |beta|``, ``||alpha| - |beta||``."""
     a, b = np.abs(alpha), np.abs(beta)
     return np.stack([a + b, np.abs(a - b)], axis=1)
+
+
+def best_turn(p: np.ndarray, q: np.ndarray) -> float:
+    """The angle, radians, of the rotation that best takes the centred flat points ``p`` onto ``q``.
+
+    Procrustes in the plane in closed form (``arctan2`` of the cross-covariance's antisymmetric and
+    symmetric parts), every product written out: a BLAS or LAPACK call rounds by the CPU's kernels (fused
+    multiply-adds on one, not on another), and what is placed by the turn would follow those bits.
+
+    Parameters
+    ----------
+    p, q : (k, 2) float64
+        Corresponding points, each set centred on its mean, any one unit.
+
+    Returns
+    -------
+    float
+        In ``(-pi, pi]``; a turn, never a mirror.
+    """
+    cos = float(np.einsum("i,i->", p[:, 0], q[:, 0]) + np.einsum("i,i->", p[:, 1], q[:, 1]))
+    sin = float(np.einsum("i,i->", p[:, 0], q[:, 1]) - np.einsum("i,i->", p[:, 1], q[:, 0]))
+    return float(np.arctan2(sin, cos))
 
 
 def signed_areas(uv: np.ndarray, faces: np.ndarray) -> np.ndarray:

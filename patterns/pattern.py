@@ -18,7 +18,7 @@ import shapely
 from .curves import Motion
 from .errors import InputError
 from .measure import Distortion, TriangleStrain, distortion, flat_direction, no_strain, triangle_strains
-from .mesh import polyline_arc
+from .mesh import extent, polyline_arc
 from .model import Model, Panel, Seam, SurfaceKind
 from .options import check_number
 from .predicates import Overlap, flat_polygon
@@ -269,7 +269,7 @@ class FlatPanel:
         spacing = check_number(spacing, "ruling spacing (mm)", low=0, low_open=True, name=f"panel {self.name}")
         uv = self.flattening.uv
         polygon = flat_polygon(uv, self.loops)
-        size = float(np.ptp(uv, axis=0).max()) * 4 + 1.0
+        size = extent(uv) * 4 + 1.0
         lines = []
         if surface.kind is SurfaceKind.CYLINDER:
             along = flat_direction(self.vertices, self.faces, uv, surface.axis)  # the rulings' direction

@@ -186,3 +186,20 @@ def test_no_strain_is_an_isometry_read_only():
     for name in ("stretch", "strain", "dominant", "direction", "area_change", "area_3d"):
         with pytest.raises(ValueError, match="read-only"):
             getattr(ts, name)[0] = 7.0
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.7, -2.5, np.pi])
+def test_best_turn_recovers_a_known_rotation_and_never_mirrors(angle):
+    """Points turned by a known angle (and nudged) come back with that angle; their mirror image gives a
+    turn, not a reflection (the blank's faces and the pinned start are placed by it)."""
+    rng = np.random.default_rng(5)
+    p = rng.normal(size=(12, 2))
+    p -= p.mean(axis=0)
+    c, s = np.cos(angle), np.sin(angle)
+    q = np.column_stack([p[:, 0] * c - p[:, 1] * s, p[:, 0] * s + p[:, 1] * c])
+    turn = measure.best_turn(p, q)
+    assert abs(np.angle(np.exp(1j * (turn - angle)))) < 1e-12
+    mirrored = p * [-1.0, 1.0]
+    t = measure.best_turn(p, mirrored)
+    residual = lambda a: np.linalg.norm(p @ np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]]) - mirrored)
+    assert residual(t) <= min(residual(a) for a in np.linspace(-np.pi, np.pi, 3601)) + 1e-9

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..files import atomic_output
+from ..mesh import extent
 from ..options import check_number, check_ratio
 from ..pattern import Pattern
 from ..pieces.drawing import row_offsets
@@ -142,7 +143,7 @@ def heat_map_figure(pattern, *, max_strain: float | None = None, title: str | No
             ring = uv[np.r_[loop, loop[:1]]]
             ax.plot(ring[:, 0], ring[:, 1], color="black", linewidth=0.8)
         panel = Polygon(uv[flat.loops[0]], [uv[loop] for loop in flat.loops[1:]])
-        size = float(np.ptp(uv[flat.loops[0]], axis=0).max())
+        size = extent(uv[flat.loops[0]])
         centre = np.array(polylabel(panel, tolerance=max(size, 1e-9) / 1000).coords[0]) if panel.is_valid \
             else uv[flat.loops[0]].mean(axis=0)  # inside the panel, as far from its edges and holes as can be
         ax.annotate(printable(flat.name), centre, ha="center", va="center", fontsize=9, parse_math=False,

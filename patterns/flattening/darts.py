@@ -65,7 +65,7 @@ import shapely
 
 from ..cut import cut_along, insert_line
 from ..measure import angle_defects, triangle_strains
-from ..mesh import edge_lengths, polyline_length, unique_edges
+from ..mesh import edge_lengths, extent, polyline_length, unique_edges
 from ..pattern import Dart, DartSearch, Flattening
 from .curvature import crown_of, gore_bound
 from .engine import flatten_mesh
@@ -556,7 +556,7 @@ def _shares(excess: np.ndarray, k: int) -> np.ndarray:
 
 def _reach(polygon, point, direction) -> float:
     """Distance from ``point`` along ``direction`` to where the straight line first leaves ``polygon``."""
-    size = float(np.ptp(np.asarray(polygon.exterior.coords), axis=0).max())
+    size = extent(np.asarray(polygon.exterior.coords))
     ray = shapely.LineString([point + 1e-9 * size * direction, point + 2.0 * size * direction])
     hits = ray.intersection(polygon.boundary)
     points = shapely.get_coordinates(hits)

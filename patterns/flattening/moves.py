@@ -16,7 +16,7 @@ import numpy as np
 import shapely
 
 from ..errors import InputError
-from ..measure import signed_areas
+from ..measure import best_turn, signed_areas
 from ..mesh import Connectivity, extent
 from ..predicates import crossing_segments
 
@@ -108,13 +108,7 @@ def align_to_pins(uv: np.ndarray, index: np.ndarray, target: np.ndarray) -> np.n
     ca, cb = a.mean(axis=0), target.mean(axis=0)
     if len(index) < 2:
         return uv + (cb - ca)
-    # the best turn in closed form (Procrustes in the plane) with every product written out: a BLAS or LAPACK
-    # call rounds by the CPU's kernels (fused multiply-adds on one, not on another), and the relaxation from
-    # this start would follow those bits
-    p, q = a - ca, target - cb
-    cos = float(np.einsum("i,i->", p[:, 0], q[:, 0]) + np.einsum("i,i->", p[:, 1], q[:, 1]))
-    sin = float(np.einsum("i,i->", p[:, 0], q[:, 1]) - np.einsum("i,i->", p[:, 1], q[:, 0]))
-    turn = np.arctan2(sin, cos)
+    turn = best_turn(a - ca, target - cb)  # no BLAS: the relaxation from this start follows its bits
     c, s = np.cos(turn), np.sin(turn)
     x, y = uv[:, 0] - ca[0], uv[:, 1] - ca[1]
     return np.column_stack([x * c - y * s + cb[0], x * s + y * c + cb[1]])

@@ -23,6 +23,7 @@ import shapely
 from ..blank import Blank
 from ..errors import InputError
 from ..findings import Finding
+from ..mesh import extent
 from ..pattern import Pattern
 from ..text import printable
 from ..units import Unit
@@ -56,7 +57,7 @@ def blank_piece(blank: Blank, options: PieceOptions | None = None) -> Piece:
 
 def _pattern_pieces(pattern: Pattern, options: PieceOptions, findings) -> list:
     check_marks(pattern.name, [fs.seam.length for fs in pattern.seams],
-                [float(np.ptp(flat.uv, axis=0).max()) for flat in pattern.panels], options)
+                [extent(flat.uv) for flat in pattern.panels], options)
     allowance_of = allowance_lookup(options.seam_allowance, {s.seam.id for s in pattern.seams}, pattern.name)
     return [panel_piece(pattern, i, allowance_of, options, findings) for i in range(len(pattern.panels))]
 

@@ -20,6 +20,7 @@ import shapely
 from ..curves import Loop
 from ..findings import Finding
 from ..measure import strain_stats, triangle_strains
+from ..mesh import extent
 from ..pattern import FlatPanel, Pattern
 from ..text import printable
 from .allowance import allowance_outline, snap, straight_runs
@@ -88,7 +89,7 @@ def _geometry(pattern: Pattern, index: int, allowance_of, options: PieceOptions)
         cut_loops = seam_loops
     cut_loops = [straight_runs(snap(loop)) for loop in cut_loops]
     label_at = shapely.get_coordinates(shapely.point_on_surface(polygon))[0]
-    height = text_height_for(float(np.ptp(seam_loops[0], axis=0).max()), options.text_height)
+    height = text_height_for(extent(seam_loops[0]), options.text_height)
     return _Geometry(index, uv, seam_loops, cut_loops, polygon, label_at, height), has_allowance
 
 

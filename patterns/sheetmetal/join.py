@@ -13,6 +13,7 @@ import numpy as np
 
 from ..curves import Motion
 from ..errors import InputError
+from ..measure import best_turn
 from ..tessellate.topology import Topology
 from .faces import edge_uv
 from .sheet import SheetModel
@@ -26,12 +27,7 @@ MEET = 0.01
 def _kabsch(src: np.ndarray, dst: np.ndarray) -> Motion:
     """The rigid motion (never a mirror) taking ``src`` (k, 2) closest to ``dst``."""
     cs, cd = src.mean(axis=0), dst.mean(axis=0)
-    a, b = src - cs, dst - cd
-    # The cross-covariance written out: a BLAS product (``a.T @ b``) rounds by the CPU's kernels, and every
-    # face's place on the blank would follow them (issue 51).
-    sin = float(np.sum(a[:, 0] * b[:, 1]) - np.sum(a[:, 1] * b[:, 0]))
-    cos = float(np.sum(a[:, 0] * b[:, 0]) + np.sum(a[:, 1] * b[:, 1]))
-    angle = float(np.arctan2(sin, cos))
+    angle = best_turn(src - cs, dst - cd)  # no BLAS: every face's place on the blank follows its bits
     turn = Motion(angle)
     shift = cd - turn(cs)
     return Motion(angle, float(shift[0]), float(shift[1]))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..mesh import extent
 from ..model import Surface, SurfaceKind
 from .remesh import evaluate
 
@@ -47,13 +48,13 @@ def _general_cone(surface, dev):
     boundary (the directrix), or None."""
 
     pts = dev.points  # (nv, nu, 3): rows along u at fixed v
-    size = float(np.ptp(pts.reshape(-1, 3), axis=0).max())
+    size = extent(pts.reshape(-1, 3))
     if size <= 0:
         return None
     sides = {"v0": (pts[0], pts), "v1": (pts[-1], pts[::-1]),
              "u0": (pts[:, 0], pts.transpose(1, 0, 2)), "u1": (pts[:, -1], pts.transpose(1, 0, 2)[::-1])}
     for key, (edge, grid) in sides.items():
-        if np.ptp(edge, axis=0).max() > 1e-9 * size:
+        if extent(edge) > 1e-9 * size:
             continue
         apex = edge.mean(axis=0)
         # grid[j] are the points at the j-th line parallel to the apex side; lines

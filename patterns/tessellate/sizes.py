@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import CadError
 from ..measure import weighted_percentile
-from ..mesh import MAX_TRIANGLES
+from ..mesh import MAX_TRIANGLES, extent
 from .topology import Topology
 
 __all__ = ["DEFAULT_TRIANGLES", "FACES_TRIANGLES", "LEAST_FACE_TRIANGLES", "MAX_TRIANGLES", "MIN_FACE_TRIANGLES", "Development", "Sizes", "face_sizes"]
@@ -106,7 +106,7 @@ class Development:
         samples are even in the parameters, and a cone's rows near the apex hold many
         samples and little area."""
         k, w = [], []
-        size = float(np.ptp(self.points.reshape(-1, 3), axis=0).max())
+        size = extent(self.points.reshape(-1, 3))
         p = self.points
         cell = np.linalg.norm(np.cross(p[1:, 1:] - p[:-1, :-1], p[1:, :-1] - p[:-1, 1:]), axis=2) / 2  # (n-1, n-1)
         node = np.zeros(p.shape[:2])
