@@ -59,6 +59,7 @@ __all__ = ["main"]
 EXIT_INPUT = 2
 """Exit codes."""
 EXIT_INTERRUPTED, EXIT_TERMINATED = signals.EXIT_INTERRUPTED, signals.EXIT_TERMINATED
+_SHOWN = 10  # places where a blank differs from --compare's drawing printed; the report has them all
 
 
 DESCRIPTION = ("Flatten 3D surfaces (CAD or mesh) into true-scale 2D cutting patterns, and unfold bent sheet-metal "
@@ -518,6 +519,10 @@ def _cmd_unfold(args) -> int:
         print(f"against {args.compare}: area {c.area_error:+.4%}, outer perimeter {c.perimeter - c.perimeter_reference:+.3f}"
               f" mm, holes {c.holes}/{c.holes_reference}, bend lines {c.bend_lines}/{c.bend_lines_reference}, outline "
               f"Hausdorff {c.hausdorff:.3f} mm ({c.within:.1%} of it within 0.1 mm)")
+        for d in c.differences[:_SHOWN]:
+            print(f"  differs: {d.describe(args.compare.name)}")
+        if len(c.differences) > _SHOWN:
+            print(f"  differs: {len(c.differences) - _SHOWN} more places (the report lists every one)")
         if len(reference.open_contours):
             print(f"  note: {counted(len(reference.open_contours), 'open contour')} of {args.compare} left out")
     if not blank.ok:

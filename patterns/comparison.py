@@ -14,7 +14,9 @@ A contour the drawing leaves open is an error, or, with
 :func:`compare_blank` sets the two side by side: area, outer perimeter, holes,
 bend lines, and how far the outlines lie apart once the best rigid motion
 (mirror allowed: a blank may be drawn from either side) has put one on the
-other (Hausdorff distance).
+other (Hausdorff distance); and where they differ (:class:`Difference`): each
+stretch of the outlines more than 0.1 mm apart, each hole of another size or
+place, each hole only one of them has.
 """
 
 from __future__ import annotations
@@ -30,10 +32,19 @@ import shapely
 from .curves import Arc, Loop
 from .errors import InputError
 
-__all__ = ["BlankComparison", "FlatPattern", "compare_blank", "read_flat_pattern"]
+__all__ = ["BlankComparison", "Difference", "FlatPattern", "compare_blank", "read_flat_pattern"]
 
 _JOIN = 1e-3
 """Contour pieces whose ends lie closer than this (mm) are joined."""
+
+APART = 0.1
+"""How far (mm) two contours may lie apart and still be the same cut: the outline's "within 0.1 mm"."""
+
+_STEP = 0.02
+"""The spacing (mm) at which contours are resampled to be measured."""
+
+_PLACE = 1.0
+"""Stretches of the outlines that differ and lie closer than this (mm) are one place (a slot's sides and its mouth)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -281,6 +292,54 @@ def _chain(pieces, path, *, leave_out: bool = False):
     return loops, left_out
 
 
+@dataclass(frozen=True)
+class Difference:
+    """One place where a blank and a reference flat pattern differ by more than :data:`APART` (0.1 mm).
+
+    Attributes
+    ----------
+    kind : {"outline", "hole", "hole-ours", "hole-reference"}
+        A stretch of the outer contours apart; a hole each at one place, of another size, shape or
+        position; a hole the reference does not have; a hole only the reference has.
+    x, y : float
+        Where, in the reference drawing's coordinates, mm: the middle of the stretch, the hole's centre.
+    distance : float
+        How far apart, mm: the largest distance from a point of one contour to the other (a hole only one
+        drawing has: its size).
+    length : float
+        ``"outline"``: how much of the two outlines (summed) lies more than :data:`APART` from the other, mm;
+        0 for holes.
+    size, size_reference : float
+        Holes: the diameter of a circle of the hole's area, ours and the reference's, mm (0 where that
+        drawing has none); 0 for the outline.
+    """
+
+    kind: str
+    x: float
+    y: float
+    distance: float
+    length: float = 0.0
+    size: float = 0.0
+    size_reference: float = 0.0
+
+    def to_dict(self) -> dict:
+        """The report's entry (mm)."""
+        return {"kind": self.kind, "x_mm": self.x, "y_mm": self.y, "distance_mm": self.distance,
+                "length_mm": self.length, "size_mm": self.size, "size_reference_mm": self.size_reference}
+
+    def describe(self, reference: str = "the reference") -> str:
+        """One line: what differs, where (in the reference's coordinates) and by how much."""
+        at = f"at x {self.x:.2f}, y {self.y:.2f} mm"
+        if self.kind == "outline":
+            return f"outline {at}: up to {self.distance:.3f} mm apart over {self.length:.1f} mm"
+        if self.kind == "hole":
+            return (f"hole {at}: Ø {self.size:.2f} in the blank, Ø {self.size_reference:.2f} in {reference} "
+                    f"({self.distance:.3f} mm apart)")
+        if self.kind == "hole-ours":
+            return f"hole {at}: Ø {self.size:.2f} in the blank, none in {reference}"
+        return f"hole {at}: none in the blank, Ø {self.size_reference:.2f} in {reference}"
+
+
 @dataclass(frozen=True, eq=False)
 class BlankComparison:
     """A blank beside a reference flat pattern (each figure ours, then theirs).
@@ -308,6 +367,8 @@ class BlankComparison:
         have rims.
     open_contours_reference : int
         Open chains the reference was read without (``open_contours="leave-out"``).
+    differences : tuple of Difference
+        Every place where the two differ by more than :data:`APART`, the farthest apart first.
     """
 
     area: float
@@ -326,6 +387,7 @@ class BlankComparison:
     rims_reference: int = 0
     hausdorff_rims: float | None = None
     open_contours_reference: int = 0
+    differences: tuple[Difference, ...] = ()
 
     @property
     def area_error(self) -> float:
@@ -339,7 +401,8 @@ class BlankComparison:
                 "bend_lines_reference": self.bend_lines_reference, "hausdorff_mm": self.hausdorff,
                 "hausdorff_all_mm": self.hausdorff_all, "within_0.1mm": self.within, "mirrored": self.mirrored,
                 "rims": self.rims, "rims_reference": self.rims_reference, "hausdorff_rims_mm": self.hausdorff_rims,
-                "open_contours_reference": self.open_contours_reference}
+                "open_contours_reference": self.open_contours_reference,
+                "differences": [d.to_dict() for d in self.differences]}
 
 
 def _resample(loop: np.ndarray, step: float) -> np.ndarray:
@@ -434,18 +497,109 @@ def compare_blank(blank, reference) -> BlankComparison:
                         np.vstack([_resample(lp, 0.02) for lp in (ref.outline, *ref.holes)]))
 
     def distances(a_loops, b_loops):
-        a = np.vstack([_resample(lp, 0.02) for lp in a_loops]) @ rot.T + shift
-        b = np.vstack([_resample(lp, 0.02) for lp in b_loops])
+        a = np.vstack([_resample(lp, _STEP) for lp in a_loops]) @ rot.T + shift
+        b = np.vstack([_resample(lp, _STEP) for lp in b_loops])
         return cKDTree(b).query(a)[0], cKDTree(a).query(b)[0]
 
     there, back = distances([outline], [ref.outline])
     rims_off = float(max(d.max() for d in distances(rims, ref.rims))) if rims and ref.rims else None
+    ours_all = [_resample(lp, _STEP) @ rot.T + shift for lp in (outline, *holes)]
+    theirs_all = [_resample(lp, _STEP) for lp in (ref.outline, *ref.holes)]
+    d_ours = cKDTree(np.vstack(theirs_all)).query(np.vstack(ours_all))[0]
+    d_theirs = cKDTree(np.vstack(ours_all)).query(np.vstack(theirs_all))[0]
+    places = _outline_places(ours_all[0], theirs_all[0], there, back)
+    places += _hole_places([h @ rot.T + shift for h in holes], ref.holes, ours_all[1:], theirs_all[1:],
+                           d_ours[len(ours_all[0]):], d_theirs[len(theirs_all[0]):])
 
     return BlankComparison(
         area=area, area_reference=ref.area, perimeter=perimeter, perimeter_reference=ref.perimeter,
         holes=len(holes), holes_reference=len(ref.holes), bend_lines=bends, bend_lines_reference=len(ref.bend_lines),
         hausdorff=float(max(there.max(), back.max())),
-        hausdorff_all=float(max(d.max() for d in distances([outline, *holes], [ref.outline, *ref.holes]))),
-        within=float(np.mean(there <= 0.1)),
+        hausdorff_all=float(max(d_ours.max(), d_theirs.max())),
+        within=float(np.mean(there <= APART)),
         mirrored=bool(np.linalg.det(rot) < 0), rims=len(rims), rims_reference=len(ref.rims), hausdorff_rims=rims_off,
-        open_contours_reference=len(ref.open_contours))
+        open_contours_reference=len(ref.open_contours),
+        differences=tuple(sorted(places, key=lambda d: (-d.distance, d.kind, d.x, d.y))))
+
+
+def _runs(far: np.ndarray) -> list[np.ndarray]:
+    """The runs of ``True`` in ``far`` ``(k,) bool``, the points of one closed contour in order: index arrays,
+    a run that wraps past the last point kept whole."""
+    if not far.any():
+        return []
+    if far.all():
+        return [np.arange(len(far))]
+    order = np.roll(np.arange(len(far)), -int(np.argmin(far)))  # start on a point that is not far
+    step = np.diff(np.r_[0, far[order].astype(np.int8), 0])
+    return [order[a:b] for a, b in zip(np.flatnonzero(step == 1), np.flatnonzero(step == -1))]
+
+
+def _outline_places(ours: np.ndarray, theirs: np.ndarray, there: np.ndarray, back: np.ndarray) -> list[Difference]:
+    """The stretches of the two outer contours (points ``(k, 2)`` every :data:`_STEP`, in the reference's
+    coordinates, with each point's distance to the other contour) more than :data:`APART` apart, those closer
+    than :data:`_PLACE` to each other one place."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    runs = [(points[r], distance[r]) for points, distance in ((ours, there), (theirs, back))
+            for r in _runs(distance > APART)]
+    if not runs:
+        return []
+    # Every fifth point (0.1 mm apart) tells which runs come within _PLACE of each other.
+    sparse = [p[::5] for p, _ in runs]
+    label = np.repeat(np.arange(len(runs)), [len(p) for p in sparse])
+    pairs = cKDTree(np.vstack(sparse)).query_pairs(_PLACE, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (label[pairs[:, 0]], label[pairs[:, 1]])), shape=(len(runs),) * 2)
+    _, place = connected_components(graph, directed=False)
+    out = []
+    for k in range(place.max() + 1):
+        members = [runs[i] for i in np.flatnonzero(place == k)]
+        points = np.vstack([p for p, _ in members])
+        x, y = points.mean(axis=0)
+        out.append(Difference("outline", float(x), float(y), float(max(d.max() for _, d in members)),
+                              length=len(points) * _STEP))
+    return out
+
+
+def _hole_places(ours, theirs, ours_sampled, theirs_sampled, d_ours, d_theirs) -> list[Difference]:
+    """The holes that differ: ``ours`` and ``theirs`` are the holes' points ``(k, 2)`` in the reference's
+    coordinates, ``*_sampled`` the same resampled, ``d_*`` each resampled point's distance to the nearest
+    contour of the other drawing.  Two holes are one hole drawn twice when either's centre lies inside the
+    other (each reference hole the mate of the nearest such hole of ours)."""
+    from scipy.spatial import cKDTree
+
+    def figures(loops):
+        polygons = np.array([shapely.Polygon(h) for h in loops], dtype=object)
+        centre = shapely.get_coordinates(shapely.centroid(polygons)) if len(loops) else np.zeros((0, 2))
+        return polygons, centre, np.sqrt(4.0 * shapely.area(polygons) / np.pi) if len(loops) else np.zeros(0)
+
+    def worst(sampled, d):
+        if not sampled:
+            return np.zeros(0)
+        return np.maximum.reduceat(d, np.r_[0, np.cumsum([len(p) for p in sampled])[:-1]])
+
+    p_ours, c_ours, size_ours = figures(ours)
+    p_theirs, c_theirs, size_theirs = figures(theirs)
+    far_ours, far_theirs = worst(ours_sampled, d_ours), worst(theirs_sampled, d_theirs)
+    mate, taken = np.full(len(ours), -1), set()
+    if len(ours) and len(theirs):
+        gap, j = cKDTree(c_theirs).query(c_ours)
+        inside = shapely.contains_xy(p_theirs[j], *c_ours.T) | shapely.contains_xy(p_ours, *c_theirs[j].T)
+        for i in np.lexsort((np.arange(len(ours)), gap)):  # the nearest first: one mate each
+            if inside[i] and int(j[i]) not in taken:
+                mate[i] = j[i]
+                taken.add(int(j[i]))
+    out = []
+    for i, k in enumerate(mate):
+        if k < 0:
+            out.append(Difference("hole-ours", *map(float, c_ours[i]), float(size_ours[i]), size=float(size_ours[i])))
+            continue
+        apart = float(max(far_ours[i], far_theirs[k]))
+        if apart > APART:
+            out.append(Difference("hole", *map(float, c_theirs[k]), apart, size=float(size_ours[i]),
+                                  size_reference=float(size_theirs[k])))
+    for k in sorted(set(range(len(theirs))) - taken):
+        out.append(Difference("hole-reference", *map(float, c_theirs[k]), float(size_theirs[k]),
+                              size_reference=float(size_theirs[k])))
+    return out

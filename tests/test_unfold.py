@@ -404,8 +404,11 @@ def test_the_center_bracket_matches_solidworks_at_the_k_it_was_made_with():
     assert blank.ok
     assert (len(blank.holes), len(blank.bends)) == (124, 18)
     assert abs(blank.perimeter - 3922.17) <= 0.5
-    assert patterns.compare_blank(blank, SHEETMETAL / f"{part}.DXF").hausdorff <= 0.1
+    c = patterns.compare_blank(blank, SHEETMETAL / f"{part}.DXF")
+    assert c.hausdorff <= 0.1
     assert not [f for f in blank.findings if f.code is patterns.Code.OBLIQUE_CUT]
+    # what differs: its sixteen M5 tapping holes (Ø 4.2 in the model) are Ø 1.5 marks in SolidWorks' DXF
+    assert [(d.kind, round(d.size, 1), round(d.size_reference, 1)) for d in c.differences] == [("hole", 4.2, 1.5)] * 16
 
 
 @pytest.mark.slow
@@ -432,6 +435,10 @@ def test_the_support_differs_from_solidworks_only_by_its_slot():
     assert there[np.linalg.norm(ours - corner, axis=1) > 3].max() <= 0.1
     assert back[np.linalg.norm(theirs - corner, axis=1) > 3].max() <= 0.1
     assert blank.perimeter - ref.perimeter == pytest.approx(-2 * 2.0, abs=0.05)
+    # compare_blank names that one place: the slot, 2 mm deep, where the far points are
+    (place,) = patterns.compare_blank(blank, ref).differences
+    assert place.kind == "outline" and place.distance == pytest.approx(2.0, abs=0.05)
+    assert np.hypot(place.x - corner[0], place.y - corner[1]) < 0.5
 
 
 @pytest.mark.slow
