@@ -522,7 +522,7 @@ def _cmd_unfold(args) -> int:
         for d in c.differences[:_SHOWN]:
             print(f"  differs: {d.describe(args.compare.name)}")
         if len(c.differences) > _SHOWN:
-            print(f"  differs: {len(c.differences) - _SHOWN} more places (the report lists every one)")
+            print(f"  differs: {counted(len(c.differences) - _SHOWN, 'more place')} (the report lists every one)")
         if len(reference.open_contours):
             print(f"  note: {counted(len(reference.open_contours), 'open contour')} of {args.compare} left out")
     if not blank.ok:

@@ -302,10 +302,11 @@ class Difference:
         A stretch of the outer contours apart; a hole each at one place, of another size, shape or
         position; a hole the reference does not have; a hole only the reference has.
     x, y : float
-        Where, in the reference drawing's coordinates, mm: the middle of the stretch, the hole's centre.
+        Where, in the reference drawing's coordinates, mm: the mean of the stretch's points (of a whole
+        contour: its centre), the reference hole's centre (ours where the reference has none).
     distance : float
-        How far apart, mm: the largest distance from a point of one contour to the other (a hole only one
-        drawing has: its size).
+        How far apart, mm: the stretch's largest distance from the other outline; the two holes' Hausdorff
+        distance; a hole only one drawing has: its size.
     length : float
         ``"outline"``: how much of the two outlines (summed) lies more than :data:`APART` from the other, mm;
         0 for holes.
@@ -323,12 +324,28 @@ class Difference:
     size_reference: float = 0.0
 
     def to_dict(self) -> dict:
-        """The report's entry (mm)."""
+        """The report's entry.
+
+        Returns
+        -------
+        dict
+            ``kind``, ``x_mm``, ``y_mm``, ``distance_mm``, ``length_mm``, ``size_mm``, ``size_reference_mm``.
+        """
         return {"kind": self.kind, "x_mm": self.x, "y_mm": self.y, "distance_mm": self.distance,
                 "length_mm": self.length, "size_mm": self.size, "size_reference_mm": self.size_reference}
 
     def describe(self, reference: str = "the reference") -> str:
-        """One line: what differs, where (in the reference's coordinates) and by how much."""
+        """One line: what differs, where (in the reference's coordinates) and by how much.
+
+        Parameters
+        ----------
+        reference : str
+            How the reference drawing is named in the line (its file's name).
+
+        Returns
+        -------
+        str
+        """
         at = f"at x {self.x:.2f}, y {self.y:.2f} mm"
         if self.kind == "outline":
             return f"outline {at}: up to {self.distance:.3f} mm apart over {self.length:.1f} mm"
@@ -480,7 +497,9 @@ def compare_blank(blank, reference) -> BlankComparison:
     by trimmed iterative closest points (the worst tenth of the pairs left out, so
     that one corner drawn differently does not shift the rest) and a simplex polish; the Hausdorff distance is then measured on contours resampled
     every 0.02 mm.  Holes are compared with holes (of a countersunk hole, the through hole) and rims with
-    rims; the reference's open contours, when it was read without them, are counted.
+    rims; the reference's open contours, when it was read without them, are counted.  ``differences``
+    lists every place the two lie more than :data:`APART` apart (:class:`Difference`), in the reference's
+    coordinates.
     """
     from scipy.spatial import cKDTree
 
@@ -494,22 +513,22 @@ def compare_blank(blank, reference) -> BlankComparison:
         rims = tuple(r.circle.points()[:-1] for r in blank.rims)
         bends, area, perimeter = len(blank.bends), blank.area, blank.perimeter
     rot, shift = _align(np.vstack([_resample(lp, 0.5) for lp in (outline, *holes)]),
-                        np.vstack([_resample(lp, 0.02) for lp in (ref.outline, *ref.holes)]))
-
-    def distances(a_loops, b_loops):
-        a = np.vstack([_resample(lp, _STEP) for lp in a_loops]) @ rot.T + shift
-        b = np.vstack([_resample(lp, _STEP) for lp in b_loops])
-        return cKDTree(b).query(a)[0], cKDTree(a).query(b)[0]
-
-    there, back = distances([outline], [ref.outline])
-    rims_off = float(max(d.max() for d in distances(rims, ref.rims))) if rims and ref.rims else None
+                        np.vstack([_resample(lp, _STEP) for lp in (ref.outline, *ref.holes)]))
+    # Every contour resampled once, ours put on theirs: (k, 2) mm each, the outline first.
     ours_all = [_resample(lp, _STEP) @ rot.T + shift for lp in (outline, *holes)]
     theirs_all = [_resample(lp, _STEP) for lp in (ref.outline, *ref.holes)]
+    there = cKDTree(theirs_all[0]).query(ours_all[0])[0]
+    back = cKDTree(ours_all[0]).query(theirs_all[0])[0]
     d_ours = cKDTree(np.vstack(theirs_all)).query(np.vstack(ours_all))[0]
     d_theirs = cKDTree(np.vstack(ours_all)).query(np.vstack(theirs_all))[0]
+    rims_off = None
+    if rims and ref.rims:
+        a = np.vstack([_resample(lp, _STEP) for lp in rims]) @ rot.T + shift
+        b = np.vstack([_resample(lp, _STEP) for lp in ref.rims])
+        rims_off = float(max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()))
     places = _outline_places(ours_all[0], theirs_all[0], there, back)
-    places += _hole_places([h @ rot.T + shift for h in holes], ref.holes, ours_all[1:], theirs_all[1:],
-                           d_ours[len(ours_all[0]):], d_theirs[len(theirs_all[0]):])
+    places += _hole_places([h @ rot.T + shift for h in holes], ref.holes, sampled=(ours_all[1:], theirs_all[1:]),
+                           nearest=(d_ours[len(ours_all[0]):], d_theirs[len(theirs_all[0]):]))
 
     return BlankComparison(
         area=area, area_reference=ref.area, perimeter=perimeter, perimeter_reference=ref.perimeter,
@@ -546,8 +565,8 @@ def _outline_places(ours: np.ndarray, theirs: np.ndarray, there: np.ndarray, bac
             for r in _runs(distance > APART)]
     if not runs:
         return []
-    # Every fifth point (0.1 mm apart) tells which runs come within _PLACE of each other.
-    sparse = [p[::5] for p, _ in runs]
+    # Points APART from each other (every fifth) tell which runs come within _PLACE of each other.
+    sparse = [p[::max(1, round(APART / _STEP))] for p, _ in runs]
     label = np.repeat(np.arange(len(runs)), [len(p) for p in sparse])
     pairs = cKDTree(np.vstack(sparse)).query_pairs(_PLACE, output_type="ndarray")
     graph = coo_matrix((np.ones(len(pairs)), (label[pairs[:, 0]], label[pairs[:, 1]])), shape=(len(runs),) * 2)
@@ -562,41 +581,64 @@ def _outline_places(ours: np.ndarray, theirs: np.ndarray, there: np.ndarray, bac
     return out
 
 
-def _hole_places(ours, theirs, ours_sampled, theirs_sampled, d_ours, d_theirs) -> list[Difference]:
-    """The holes that differ: ``ours`` and ``theirs`` are the holes' points ``(k, 2)`` in the reference's
-    coordinates, ``*_sampled`` the same resampled, ``d_*`` each resampled point's distance to the nearest
-    contour of the other drawing.  Two holes are one hole drawn twice when either's centre lies inside the
-    other (each reference hole the mate of the nearest such hole of ours)."""
+def _hole_places(ours: list[np.ndarray], theirs: list[np.ndarray], *, sampled, nearest) -> list[Difference]:
+    """The holes that differ.
+
+    Two holes are one hole drawn twice when either's centre lies inside the other; of the pairs so
+    found, those that look most alike go first (the gap between their centres plus half the difference
+    of their sizes: for two circles, their Hausdorff distance), each hole in one pair at most.
+
+    Parameters
+    ----------
+    ours, theirs : list of (k, 2) float64
+        The holes' points, mm, ours already in the reference's coordinates.
+    sampled : tuple of (list of (k, 2) float64, list of (k, 2) float64)
+        The same holes resampled every :data:`_STEP`, ours then theirs.
+    nearest : tuple of ((k,) float64, (k,) float64)
+        Each resampled point's distance to the nearest contour of the other drawing, mm, the holes'
+        points in the order of ``sampled``, ours then theirs.
+
+    Returns
+    -------
+    list of Difference
+        A ``"hole"`` for each pair more than :data:`APART` apart (the pair's own Hausdorff distance), a
+        ``"hole-ours"`` or ``"hole-reference"`` for each hole with no mate.
+    """
     from scipy.spatial import cKDTree
 
     def figures(loops):
         polygons = np.array([shapely.Polygon(h) for h in loops], dtype=object)
-        centre = shapely.get_coordinates(shapely.centroid(polygons)) if len(loops) else np.zeros((0, 2))
-        return polygons, centre, np.sqrt(4.0 * shapely.area(polygons) / np.pi) if len(loops) else np.zeros(0)
+        if not len(loops):
+            return polygons, np.zeros((0, 2)), np.zeros(0)
+        return polygons, shapely.get_coordinates(shapely.centroid(polygons)), np.sqrt(4.0 * shapely.area(polygons) / np.pi)
 
-    def worst(sampled, d):
-        if not sampled:
+    def worst(loops, d):
+        if not loops:
             return np.zeros(0)
-        return np.maximum.reduceat(d, np.r_[0, np.cumsum([len(p) for p in sampled])[:-1]])
+        return np.maximum.reduceat(d, np.r_[0, np.cumsum([len(p) for p in loops])[:-1]])
 
     p_ours, c_ours, size_ours = figures(ours)
     p_theirs, c_theirs, size_theirs = figures(theirs)
-    far_ours, far_theirs = worst(ours_sampled, d_ours), worst(theirs_sampled, d_theirs)
+    far_ours, far_theirs = worst(sampled[0], nearest[0]), worst(sampled[1], nearest[1])
     mate, taken = np.full(len(ours), -1), set()
     if len(ours) and len(theirs):
-        gap, j = cKDTree(c_theirs).query(c_ours)
-        inside = shapely.contains_xy(p_theirs[j], *c_ours.T) | shapely.contains_xy(p_ours, *c_theirs[j].T)
-        for i in np.lexsort((np.arange(len(ours)), gap)):  # the nearest first: one mate each
-            if inside[i] and int(j[i]) not in taken:
-                mate[i] = j[i]
-                taken.add(int(j[i]))
+        # (ours, theirs) index pairs: our centre in their hole, or their centre in ours
+        a = shapely.STRtree(p_theirs).query(shapely.points(c_ours), predicate="within")
+        b = shapely.STRtree(p_ours).query(shapely.points(c_theirs), predicate="within")
+        pairs = np.unique(np.hstack([a, b[::-1]]), axis=1)
+        i, k = pairs
+        unlike = np.hypot(*(c_ours[i] - c_theirs[k]).T) + 0.5 * np.abs(size_ours[i] - size_theirs[k])
+        for n in np.lexsort((k, i, unlike)):  # the most alike first, ties by index: one mate each
+            if mate[i[n]] < 0 and int(k[n]) not in taken:
+                mate[i[n]] = k[n]
+                taken.add(int(k[n]))
     out = []
     for i, k in enumerate(mate):
         if k < 0:
             out.append(Difference("hole-ours", *map(float, c_ours[i]), float(size_ours[i]), size=float(size_ours[i])))
-            continue
-        apart = float(max(far_ours[i], far_theirs[k]))
-        if apart > APART:
+        elif max(far_ours[i], far_theirs[k]) > APART:  # some point lies farther than APART from every contour
+            mine, yours = sampled[0][i], sampled[1][k]
+            apart = float(max(cKDTree(yours).query(mine)[0].max(), cKDTree(mine).query(yours)[0].max()))
             out.append(Difference("hole", *map(float, c_theirs[k]), apart, size=float(size_ours[i]),
                                   size_reference=float(size_theirs[k])))
     for k in sorted(set(range(len(theirs))) - taken):
