@@ -525,7 +525,7 @@ def compare_blank(blank, reference) -> BlankComparison:
     if rims and ref.rims:
         a = np.vstack([_resample(lp, _STEP) for lp in rims]) @ rot.T + shift
         b = np.vstack([_resample(lp, _STEP) for lp in ref.rims])
-        rims_off = float(max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()))
+        rims_off = _hausdorff(a, b)
     places = _outline_places(ours_all[0], theirs_all[0], there, back)
     places += _hole_places([h @ rot.T + shift for h in holes], ref.holes, sampled=(ours_all[1:], theirs_all[1:]),
                            nearest=(d_ours[len(ours_all[0]):], d_theirs[len(theirs_all[0]):]))
@@ -539,6 +539,12 @@ def compare_blank(blank, reference) -> BlankComparison:
         mirrored=bool(np.linalg.det(rot) < 0), rims=len(rims), rims_reference=len(ref.rims), hausdorff_rims=rims_off,
         open_contours_reference=len(ref.open_contours),
         differences=tuple(sorted(places, key=lambda d: (-d.distance, d.kind, d.x, d.y))))
+
+
+def _hausdorff(a: np.ndarray, b: np.ndarray) -> float:
+    """The Hausdorff distance of two point sets ``(k, 2)`` (contours resampled every :data:`_STEP`), mm."""
+    from scipy.spatial import cKDTree
+    return float(max(cKDTree(b).query(a)[0].max(), cKDTree(a).query(b)[0].max()))
 
 
 def _runs(far: np.ndarray) -> list[np.ndarray]:
@@ -604,8 +610,6 @@ def _hole_places(ours: list[np.ndarray], theirs: list[np.ndarray], *, sampled, n
         A ``"hole"`` for each pair more than :data:`APART` apart (the pair's own Hausdorff distance), a
         ``"hole-ours"`` or ``"hole-reference"`` for each hole with no mate.
     """
-    from scipy.spatial import cKDTree
-
     def figures(loops):
         polygons = np.array([shapely.Polygon(h) for h in loops], dtype=object)
         if not len(loops):
@@ -637,8 +641,7 @@ def _hole_places(ours: list[np.ndarray], theirs: list[np.ndarray], *, sampled, n
         if k < 0:
             out.append(Difference("hole-ours", *map(float, c_ours[i]), float(size_ours[i]), size=float(size_ours[i])))
         elif max(far_ours[i], far_theirs[k]) > APART:  # some point lies farther than APART from every contour
-            mine, yours = sampled[0][i], sampled[1][k]
-            apart = float(max(cKDTree(yours).query(mine)[0].max(), cKDTree(mine).query(yours)[0].max()))
+            apart = _hausdorff(sampled[0][i], sampled[1][k])
             out.append(Difference("hole", *map(float, c_theirs[k]), apart, size=float(size_ours[i]),
                                   size_reference=float(size_theirs[k])))
     for k in sorted(set(range(len(theirs))) - taken):
